@@ -1,0 +1,28 @@
+//! One error type for the core: every error says what is wrong and where.
+
+use thiserror::Error;
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum Error {
+    /// A scene (file or string) breaks the format's rules. `at` names the place:
+    /// `features[2] "nose"`, `keyframes[1] (frame 1024)`, `field.b`, ...
+    #[error("scene: {at}: {message}")]
+    Scene { at: String, message: String },
+    /// Input that is well formed but cannot be used (sizes, empty feature sets).
+    #[error("{0}")]
+    Invalid(String),
+    /// Something this build does not do (yet).
+    #[error("not supported: {0}")]
+    Unsupported(String),
+}
+
+impl Error {
+    pub fn scene(at: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Scene {
+            at: at.into(),
+            message: message.into(),
+        }
+    }
+}

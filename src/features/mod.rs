@@ -1,0 +1,116 @@
+//! Feature primitives: points, directed lines, polylines and Catmull-Rom curves,
+//! each with a position on image A and one on image B (seed 000 §4.2).
+
+mod catmull_rom;
+mod sampling;
+
+pub use catmull_rom::catmull_rom;
+pub use sampling::{sample_points, PointPair, DEFAULT_SAMPLES_PER_SEGMENT};
+
+use crate::geom::Vec2;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FeatureKind {
+    Point,
+    /// A directed segment P → Q.
+    Line,
+    Polyline,
+    /// Catmull-Rom spline through its control points.
+    Curve,
+}
+
+impl FeatureKind {
+    pub const ALL: [FeatureKind; 4] = [
+        FeatureKind::Point,
+        FeatureKind::Line,
+        FeatureKind::Polyline,
+        FeatureKind::Curve,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FeatureKind::Point => "point",
+            FeatureKind::Line => "line",
+            FeatureKind::Polyline => "polyline",
+            FeatureKind::Curve => "curve",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == s)
+    }
+
+    /// The point counts this kind accepts: `(min, max)`.
+    pub fn point_count(self) -> (usize, usize) {
+        match self {
+            FeatureKind::Point => (1, 1),
+            FeatureKind::Line => (2, 2),
+            FeatureKind::Polyline | FeatureKind::Curve => (2, usize::MAX),
+        }
+    }
+}
+
+/// A feature with corresponding positions on image A and image B.
+/// `a.len() == b.len()` is an invariant (the scene parser enforces it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Feature {
+    pub name: Option<String>,
+    pub kind: FeatureKind,
+    pub a: Vec<Vec2>,
+    pub b: Vec<Vec2>,
+}
+
+/// Where a feature sits on one image, or in between.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    A,
+    B,
+}
+
+impl Feature {
+    pub fn new(kind: FeatureKind, a: Vec<Vec2>, b: Vec<Vec2>) -> Self {
+        Feature {
+            name: None,
+            kind,
+            a,
+            b,
+        }
+    }
+
+    pub fn line(a: [Vec2; 2], b: [Vec2; 2]) -> Self {
+        Feature::new(FeatureKind::Line, a.to_vec(), b.to_vec())
+    }
+
+    pub fn point(a: Vec2, b: Vec2) -> Self {
+        Feature::new(FeatureKind::Point, vec![a], vec![b])
+    }
+
+    pub fn named(mut self, name: impl Into<String>) -> Self {
+        self.name = Some(name.into());
+        self
+    }
+
+    pub fn points(&self, side: Side) -> &[Vec2] {
+        match side {
+            Side::A => &self.a,
+            Side::B => &self.b,
+        }
+    }
+
+    /// Control points interpolated linearly from A (t = 0) to B (t = 1).
+    pub fn points_at(&self, t: f64) -> Vec<Vec2> {
+        self.a
+            .iter()
+            .zip(&self.b)
+            .map(|(a, b)| a.lerp(*b, t))
+            .collect()
+    }
+
+    /// How the feature is called in messages: its name, or its index.
+    pub fn label(&self, index: usize) -> String {
+        match &self.name {
+            Some(n) => format!("features[{index}] \"{n}\""),
+            None => format!("features[{index}]"),
+        }
+    }
+}

@@ -1,0 +1,89 @@
+//! Uniform sampling of polylines and curves into corresponding points
+//! (seed 000 §4.2: "20 points per segment"), shared by every point-based method
+//! and by the field method's treatment of curves.
+
+use super::{catmull_rom, Feature, FeatureKind, Side};
+use crate::geom::Vec2;
+
+pub const DEFAULT_SAMPLES_PER_SEGMENT: usize = 20;
+
+/// A corresponding pair of positions on A and B.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointPair {
+    pub a: Vec2,
+    pub b: Vec2,
+}
+
+impl Feature {
+    /// The feature's points on one side, sampled `per_segment` times per span
+    /// (end point included once). Points and lines return their control points.
+    pub fn sampled(&self, side: Side, per_segment: usize) -> Vec<Vec2> {
+        sample_points(self.kind, self.points(side), per_segment)
+    }
+
+    /// Corresponding point pairs along the feature (same sampling on both sides,
+    /// so the i-th samples correspond).
+    pub fn point_pairs(&self, per_segment: usize) -> Vec<PointPair> {
+        let a = self.sampled(Side::A, per_segment);
+        let b = self.sampled(Side::B, per_segment);
+        a.into_iter()
+            .zip(b)
+            .map(|(a, b)| PointPair { a, b })
+            .collect()
+    }
+}
+
+pub fn sample_points(kind: FeatureKind, points: &[Vec2], per_segment: usize) -> Vec<Vec2> {
+    let per_segment = per_segment.max(1);
+    match kind {
+        FeatureKind::Point | FeatureKind::Line => points.to_vec(),
+        FeatureKind::Polyline | FeatureKind::Curve => {
+            let spans = points.len().saturating_sub(1);
+            let mut out = Vec::with_capacity(spans * per_segment + 1);
+            for span in 0..spans {
+                for k in 0..per_segment {
+                    let s = k as f64 / per_segment as f64;
+                    out.push(match kind {
+                        FeatureKind::Curve => catmull_rom(points, span, s),
+                        _ => points[span].lerp(points[span + 1], s),
+                    });
+                }
+            }
+            out.extend(points.last().copied());
+            out
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polyline_sampling_is_uniform_per_segment_and_keeps_control_points() {
+        let pts = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(20.0, 0.0),
+            Vec2::new(20.0, 10.0),
+        ];
+        let f = Feature::new(FeatureKind::Polyline, pts.clone(), pts.clone());
+        let s = f.sampled(Side::A, 20);
+        assert_eq!(s.len(), 41);
+        assert_eq!(s[0], pts[0]);
+        assert_eq!(s[20], pts[1]);
+        assert_eq!(s[40], pts[2]);
+        assert_eq!(s[1], Vec2::new(1.0, 0.0));
+        assert_eq!(s[21], Vec2::new(20.0, 0.5));
+    }
+
+    #[test]
+    fn pairs_correspond_index_by_index() {
+        let a = vec![Vec2::new(0.0, 0.0), Vec2::new(10.0, 0.0)];
+        let b = vec![Vec2::new(0.0, 5.0), Vec2::new(0.0, 15.0)];
+        let f = Feature::new(FeatureKind::Curve, a, b);
+        let pairs = f.point_pairs(4);
+        assert_eq!(pairs.len(), 5);
+        assert_eq!(pairs[2].a, Vec2::new(5.0, 0.0));
+        assert_eq!(pairs[2].b, Vec2::new(0.0, 10.0));
+    }
+}

@@ -1,0 +1,170 @@
+//! Plain 2-D geometry in canonical coordinates (f64: feature math wants the headroom).
+
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
+
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(from = "[f64; 2]", into = "[f64; 2]")]
+pub struct Vec2 {
+    pub x: f64,
+    pub y: f64,
+}
+
+impl From<[f64; 2]> for Vec2 {
+    fn from([x, y]: [f64; 2]) -> Self {
+        Vec2 { x, y }
+    }
+}
+
+impl From<Vec2> for [f64; 2] {
+    fn from(v: Vec2) -> Self {
+        [v.x, v.y]
+    }
+}
+
+impl Vec2 {
+    pub const ZERO: Vec2 = Vec2 { x: 0.0, y: 0.0 };
+
+    pub const fn new(x: f64, y: f64) -> Self {
+        Vec2 { x, y }
+    }
+    pub fn dot(self, o: Vec2) -> f64 {
+        self.x * o.x + self.y * o.y
+    }
+    /// The left perpendicular, same length (Beier-Neely's `Perpendicular()`; any
+    /// consistent choice works, we take the counter-clockwise one).
+    pub fn perp(self) -> Vec2 {
+        Vec2::new(-self.y, self.x)
+    }
+    pub fn length_squared(self) -> f64 {
+        self.dot(self)
+    }
+    pub fn length(self) -> f64 {
+        self.length_squared().sqrt()
+    }
+    pub fn lerp(self, o: Vec2, t: f64) -> Vec2 {
+        Vec2::new(self.x + (o.x - self.x) * t, self.y + (o.y - self.y) * t)
+    }
+    pub fn is_finite(self) -> bool {
+        self.x.is_finite() && self.y.is_finite()
+    }
+    pub fn distance(self, o: Vec2) -> f64 {
+        (self - o).length()
+    }
+}
+
+impl Add for Vec2 {
+    type Output = Vec2;
+    fn add(self, o: Vec2) -> Vec2 {
+        Vec2::new(self.x + o.x, self.y + o.y)
+    }
+}
+impl AddAssign for Vec2 {
+    fn add_assign(&mut self, o: Vec2) {
+        self.x += o.x;
+        self.y += o.y;
+    }
+}
+impl Sub for Vec2 {
+    type Output = Vec2;
+    fn sub(self, o: Vec2) -> Vec2 {
+        Vec2::new(self.x - o.x, self.y - o.y)
+    }
+}
+impl Mul<f64> for Vec2 {
+    type Output = Vec2;
+    fn mul(self, s: f64) -> Vec2 {
+        Vec2::new(self.x * s, self.y * s)
+    }
+}
+impl Div<f64> for Vec2 {
+    type Output = Vec2;
+    fn div(self, s: f64) -> Vec2 {
+        Vec2::new(self.x / s, self.y / s)
+    }
+}
+impl Neg for Vec2 {
+    type Output = Vec2;
+    fn neg(self) -> Vec2 {
+        Vec2::new(-self.x, -self.y)
+    }
+}
+
+/// An integer pixel rectangle `[x1, x2) × [y1, y2)` (OFX `OfxRectI` semantics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct RectI {
+    pub x1: i32,
+    pub y1: i32,
+    pub x2: i32,
+    pub y2: i32,
+}
+
+impl RectI {
+    pub const fn new(x1: i32, y1: i32, x2: i32, y2: i32) -> Self {
+        RectI { x1, y1, x2, y2 }
+    }
+    pub const fn from_size(width: usize, height: usize) -> Self {
+        RectI::new(0, 0, width as i32, height as i32)
+    }
+    pub fn width(&self) -> usize {
+        (self.x2 - self.x1).max(0) as usize
+    }
+    pub fn height(&self) -> usize {
+        (self.y2 - self.y1).max(0) as usize
+    }
+    pub fn is_empty(&self) -> bool {
+        self.width() == 0 || self.height() == 0
+    }
+    pub fn area(&self) -> usize {
+        self.width() * self.height()
+    }
+    pub fn contains(&self, other: &RectI) -> bool {
+        other.is_empty()
+            || (self.x1 <= other.x1
+                && self.y1 <= other.y1
+                && other.x2 <= self.x2
+                && other.y2 <= self.y2)
+    }
+    pub fn intersect(&self, o: &RectI) -> RectI {
+        let r = RectI::new(
+            self.x1.max(o.x1),
+            self.y1.max(o.y1),
+            self.x2.min(o.x2),
+            self.y2.min(o.y2),
+        );
+        if r.x2 <= r.x1 || r.y2 <= r.y1 {
+            RectI::default()
+        } else {
+            r
+        }
+    }
+}
+
+/// How pixel indices of an image at some render scale relate to canonical
+/// coordinates: `canonical = pixel / scale` per axis, where `scale.x` already
+/// folds in the pixel aspect ratio (`render_scale.x / par`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelScale {
+    pub x: f64,
+    pub y: f64,
+}
+
+impl PixelScale {
+    pub const UNIT: PixelScale = PixelScale { x: 1.0, y: 1.0 };
+
+    pub fn new(render_scale_x: f64, render_scale_y: f64, pixel_aspect: f64) -> Self {
+        PixelScale {
+            x: render_scale_x / pixel_aspect,
+            y: render_scale_y,
+        }
+    }
+    /// Canonical position of the centre of pixel `(i, j)`.
+    pub fn pixel_centre(&self, i: i32, j: i32) -> Vec2 {
+        Vec2::new((i as f64 + 0.5) / self.x, (j as f64 + 0.5) / self.y)
+    }
+    pub fn to_pixel(&self, p: Vec2) -> Vec2 {
+        Vec2::new(p.x * self.x, p.y * self.y)
+    }
+    pub fn is_unit(&self) -> bool {
+        *self == PixelScale::UNIT
+    }
+}

@@ -1,0 +1,244 @@
+//! Images as views over rows with any stride (negative too, as hosts send), so
+//! the plugin can wrap host buffers without copying, and owned float images for
+//! the harness and tests.
+//!
+//! A view's rows are addressed bottom-up in canonical pixel indices: pixel
+//! `(i, j)` of `bounds` starts at `base + (j - y1) * row_stride + (i - x1) * channels`.
+
+pub mod resample;
+mod sample;
+
+pub use resample::{resample, ResampleSettings};
+pub use sample::{EdgeMode, Filter, Sampler};
+
+use crate::error::{Error, Result};
+use crate::geom::RectI;
+
+/// A pixel component type a host may send: 8-bit, 16-bit or 32-bit float.
+pub trait Sample: Copy + Send + Sync + Default + PartialEq + std::fmt::Debug + 'static {
+    fn to_f32(self) -> f32;
+    fn from_f32(v: f32) -> Self;
+}
+
+impl Sample for f32 {
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        v
+    }
+}
+
+impl Sample for u8 {
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self as f32 * (1.0 / 255.0)
+    }
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        (v * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+    }
+}
+
+impl Sample for u16 {
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self as f32 * (1.0 / 65535.0)
+    }
+    #[inline(always)]
+    fn from_f32(v: f32) -> Self {
+        (v * 65535.0 + 0.5).clamp(0.0, 65535.0) as u16
+    }
+}
+
+/// Where each row of a view lives in its slice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Layout {
+    pub bounds: RectI,
+    pub channels: usize,
+    /// Index of pixel `(x1, y1)`.
+    pub base: usize,
+    /// Elements from one row to the next row up (negative for top-down memory).
+    pub row_stride: isize,
+}
+
+impl Layout {
+    /// Tightly packed rows, bottom row first.
+    pub fn packed(bounds: RectI, channels: usize) -> Self {
+        Layout {
+            bounds,
+            channels,
+            base: 0,
+            row_stride: (bounds.width() * channels) as isize,
+        }
+    }
+
+    fn row_start(&self, j: i32) -> usize {
+        (self.base as isize + (j - self.bounds.y1) as isize * self.row_stride) as usize
+    }
+
+    fn row_len(&self) -> usize {
+        self.bounds.width() * self.channels
+    }
+
+    /// Checks that every row lies inside a slice of `len` elements and that rows do not overlap.
+    fn check(&self, len: usize) -> Result<()> {
+        if self.channels == 0 {
+            return Err(Error::Invalid("image has no channels".into()));
+        }
+        if self.bounds.is_empty() {
+            return Ok(());
+        }
+        if (self.row_stride.unsigned_abs()) < self.row_len() && self.bounds.height() > 1 {
+            return Err(Error::Invalid(format!(
+                "image rows overlap: stride {} elements for rows of {}",
+                self.row_stride,
+                self.row_len()
+            )));
+        }
+        let first = self.base as isize;
+        let last = first + (self.bounds.height() as isize - 1) * self.row_stride;
+        let (lo, hi) = (first.min(last), first.max(last) + self.row_len() as isize);
+        if lo < 0 || hi as usize > len {
+            return Err(Error::Invalid(format!(
+                "image rows reach outside their buffer ({lo}..{hi} of {len} elements)"
+            )));
+        }
+        Ok(())
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct ImageView<'a, T> {
+    data: &'a [T],
+    layout: Layout,
+}
+
+impl<'a, T: Sample> ImageView<'a, T> {
+    pub fn new(data: &'a [T], layout: Layout) -> Result<Self> {
+        layout.check(data.len())?;
+        Ok(ImageView { data, layout })
+    }
+    pub fn bounds(&self) -> RectI {
+        self.layout.bounds
+    }
+    pub fn channels(&self) -> usize {
+        self.layout.channels
+    }
+    /// Row `j` (must be inside the bounds), `width * channels` elements.
+    #[inline]
+    pub fn row(&self, j: i32) -> &'a [T] {
+        let s = self.layout.row_start(j);
+        &self.data[s..s + self.layout.row_len()]
+    }
+    /// Pixel `(i, j)` (must be inside the bounds).
+    #[inline]
+    pub fn pixel(&self, i: i32, j: i32) -> &'a [T] {
+        let c = self.layout.channels;
+        let k = self.layout.row_start(j) + (i - self.layout.bounds.x1) as usize * c;
+        &self.data[k..k + c]
+    }
+}
+
+#[derive(Debug)]
+pub struct ImageViewMut<'a, T> {
+    data: &'a mut [T],
+    layout: Layout,
+}
+
+impl<'a, T: Sample> ImageViewMut<'a, T> {
+    pub fn new(data: &'a mut [T], layout: Layout) -> Result<Self> {
+        layout.check(data.len())?;
+        Ok(ImageViewMut { data, layout })
+    }
+    pub fn bounds(&self) -> RectI {
+        self.layout.bounds
+    }
+    pub fn channels(&self) -> usize {
+        self.layout.channels
+    }
+    pub fn as_view(&self) -> ImageView<'_, T> {
+        ImageView {
+            data: self.data,
+            layout: self.layout,
+        }
+    }
+    /// Every row as its own mutable slice, `(j, row)`, so rows can be written
+    /// in parallel whatever the stride's sign.
+    pub fn rows_mut(&mut self) -> Vec<(i32, &mut [T])> {
+        let l = self.layout;
+        let mut starts: Vec<(usize, i32)> = (l.bounds.y1..l.bounds.y2)
+            .map(|j| (l.row_start(j), j))
+            .collect();
+        starts.sort_unstable();
+        let mut rows = Vec::with_capacity(starts.len());
+        let mut rest: &mut [T] = self.data;
+        let mut consumed = 0;
+        for (start, j) in starts {
+            let tail = std::mem::take(&mut rest);
+            let (_, tail) = tail.split_at_mut(start - consumed);
+            let (row, tail) = tail.split_at_mut(l.row_len());
+            consumed = start + l.row_len();
+            rest = tail;
+            rows.push((j, row));
+        }
+        rows
+    }
+}
+
+/// An owned float image: packed rows, bottom row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    pub bounds: RectI,
+    pub channels: usize,
+    pub data: Vec<f32>,
+}
+
+impl Image {
+    pub fn new(bounds: RectI, channels: usize) -> Self {
+        Image {
+            bounds,
+            channels,
+            data: vec![0.0; bounds.area() * channels],
+        }
+    }
+    pub fn from_fn(bounds: RectI, channels: usize, f: impl Fn(i32, i32, usize) -> f32) -> Self {
+        let mut img = Image::new(bounds, channels);
+        let mut k = 0;
+        for j in bounds.y1..bounds.y2 {
+            for i in bounds.x1..bounds.x2 {
+                for c in 0..channels {
+                    img.data[k] = f(i, j, c);
+                    k += 1;
+                }
+            }
+        }
+        img
+    }
+    pub fn width(&self) -> usize {
+        self.bounds.width()
+    }
+    pub fn height(&self) -> usize {
+        self.bounds.height()
+    }
+    pub fn layout(&self) -> Layout {
+        Layout::packed(self.bounds, self.channels)
+    }
+    pub fn view(&self) -> ImageView<'_, f32> {
+        ImageView::new(&self.data, self.layout()).expect("packed layout fits its buffer")
+    }
+    pub fn view_mut(&mut self) -> ImageViewMut<'_, f32> {
+        let layout = self.layout();
+        ImageViewMut::new(&mut self.data, layout).expect("packed layout fits its buffer")
+    }
+    pub fn pixel(&self, i: i32, j: i32) -> &[f32] {
+        let k = ((j - self.bounds.y1) as usize * self.width() + (i - self.bounds.x1) as usize)
+            * self.channels;
+        &self.data[k..k + self.channels]
+    }
+}
+
+#[cfg(test)]
+mod tests;

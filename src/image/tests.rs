@@ -1,0 +1,141 @@
+use super::*;
+use crate::geom::{PixelScale, RectI};
+use crate::warp::{field::FieldWarp, Identity, Warp};
+
+fn ramp(bounds: RectI) -> Image {
+    Image::from_fn(bounds, 4, |i, j, c| {
+        (i * 3 + j * 7) as f32 + c as f32 * 0.25
+    })
+}
+
+#[test]
+fn negative_stride_views_read_the_same_pixels() {
+    let img = ramp(RectI::new(5, -3, 13, 4));
+    // Same pixels, top row first in memory.
+    let (w, h, c) = (img.width(), img.height(), 4);
+    let mut flipped = vec![0f32; img.data.len()];
+    for r in 0..h {
+        flipped[(h - 1 - r) * w * c..(h - r) * w * c]
+            .copy_from_slice(&img.data[r * w * c..(r + 1) * w * c]);
+    }
+    let layout = Layout {
+        bounds: img.bounds,
+        channels: 4,
+        base: (h - 1) * w * c,
+        row_stride: -((w * c) as isize),
+    };
+    let view = ImageView::new(&flipped, layout).unwrap();
+    for j in img.bounds.y1..img.bounds.y2 {
+        for i in img.bounds.x1..img.bounds.x2 {
+            assert_eq!(view.pixel(i, j), img.pixel(i, j));
+        }
+    }
+}
+
+#[test]
+fn layouts_that_leave_their_buffer_are_refused() {
+    let data = vec![0f32; 10];
+    let layout = Layout::packed(RectI::from_size(3, 2), 2);
+    assert!(ImageView::new(&data, layout).is_err());
+}
+
+#[test]
+fn rows_mut_splits_negative_strides() {
+    let mut data = vec![0u8; 2 * 3 * 4];
+    let layout = Layout {
+        bounds: RectI::new(0, 0, 2, 3),
+        channels: 4,
+        base: 16,
+        row_stride: -8,
+    };
+    let mut view = ImageViewMut::new(&mut data, layout).unwrap();
+    for (j, row) in view.rows_mut() {
+        row.fill(j as u8 + 1);
+    }
+    assert_eq!(&data[16..24], &[1u8; 8]);
+    assert_eq!(&data[0..8], &[3u8; 8]);
+}
+
+#[test]
+fn identity_resampling_is_bit_exact_for_every_filter_and_edge() {
+    let img = ramp(RectI::new(-4, 2, 20, 17));
+    let map = Identity.map_window(img.bounds, PixelScale::UNIT);
+    for filter in [Filter::Bilinear, Filter::Bicubic] {
+        for edge in [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror] {
+            let mut out = Image::new(img.bounds, 4);
+            let s = ResampleSettings {
+                filter,
+                edge,
+                premultiplied: true,
+            };
+            resample(img.view(), PixelScale::UNIT, &map, &mut out.view_mut(), s);
+            assert_eq!(out, img, "{filter:?} {edge:?}");
+        }
+    }
+}
+
+#[test]
+fn bilinear_half_pixel_shift_averages_neighbours() {
+    let img = Image::from_fn(RectI::from_size(8, 1), 1, |i, _, _| i as f32);
+    let shift = crate::warp::field::FieldWarp::new(
+        vec![crate::warp::field::LinePair {
+            dst: (crate::Vec2::new(0.0, 0.0), crate::Vec2::new(10.0, 0.0)),
+            src: (crate::Vec2::new(0.5, 0.0), crate::Vec2::new(10.5, 0.0)),
+        }],
+        &crate::warp::field::FieldSettings {
+            evaluation: crate::warp::field::Evaluation::Exact,
+            ..Default::default()
+        },
+    );
+    let map = shift.map_window(img.bounds, PixelScale::UNIT);
+    let mut out = Image::new(img.bounds, 1);
+    resample(
+        img.view(),
+        PixelScale::UNIT,
+        &map,
+        &mut out.view_mut(),
+        ResampleSettings::default(),
+    );
+    for i in 0..7 {
+        assert!(
+            (out.data[i] - (i as f32 + 0.5)).abs() < 1e-4,
+            "{i}: {}",
+            out.data[i]
+        );
+    }
+    // Clamp edge: the last pixel reads itself and its clamped neighbour.
+    assert!((out.data[7] - 7.0).abs() < 1e-4);
+    let _ = FieldWarp::new(Vec::new(), &Default::default());
+}
+
+#[test]
+fn eight_and_sixteen_bit_round_trip_through_float() {
+    for v in [0u8, 1, 127, 128, 254, 255] {
+        assert_eq!(u8::from_f32(v.to_f32()), v);
+    }
+    for v in [0u16, 1, 32767, 65534, 65535] {
+        assert_eq!(u16::from_f32(v.to_f32()), v);
+    }
+    assert_eq!(u8::from_f32(7.5), 255);
+    assert_eq!(u8::from_f32(-1.0), 0);
+}
+
+#[test]
+fn straight_alpha_filtering_does_not_bleed_transparent_colour() {
+    // Left pixel: opaque red; right pixel: transparent but green (garbage colour).
+    let img = Image::from_fn(RectI::from_size(2, 1), 4, |i, _, c| match (i, c) {
+        (0, 0) | (0, 3) => 1.0,
+        (1, 1) => 1.0,
+        _ => 0.0,
+    });
+    let s = Sampler::new(
+        img.view(),
+        PixelScale::UNIT,
+        Filter::Bilinear,
+        EdgeMode::Clamp,
+        false,
+    );
+    let mut px = [0.0; 4];
+    s.sample(1.0, 0.5, &mut px);
+    assert_eq!(px, [1.0, 0.0, 0.0, 0.5]);
+}

@@ -1,0 +1,22 @@
+//! MorphFX core: everything a morph needs, with no knowledge of hosts or FFI.
+//!
+//! Data flows one way (see `DESIGN.md`):
+//! scene → [`features`] at time → warp generator ([`warp`]) → warp field
+//! → resampling ([`image`]) → dissolve ([`morph`]).
+//!
+//! Coordinates are canonical pixel coordinates of the full-resolution image:
+//! x right, **y up**, origin at the bottom-left corner, pixel `(i, j)` centred
+//! at `(i + 0.5, j + 0.5)` (CONTRACT §1).
+#![forbid(unsafe_code)]
+
+pub mod error;
+pub mod features;
+pub mod geom;
+pub mod image;
+pub mod morph;
+pub mod scene;
+pub mod views;
+pub mod warp;
+
+pub use error::{Error, Result};
+pub use geom::Vec2;

@@ -1,0 +1,163 @@
+//! The scene: a CONTRACT §2 `*.morph.json` document, parsed, validated and
+//! queried for the features and the progress at any frame.
+
+mod parse;
+#[cfg(test)]
+mod tests;
+
+use crate::features::{Feature, DEFAULT_SAMPLES_PER_SEGMENT};
+use crate::warp::field::FieldSettings;
+
+pub use parse::FORMAT;
+
+/// The warp generator a scene asks for (CONTRACT §2 `method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Method {
+    #[default]
+    Field,
+    Mesh,
+    Triangles,
+    ThinPlate,
+    Mffd,
+    Hybrid,
+    Auto,
+}
+
+impl Method {
+    pub const ALL: [Method; 7] = [
+        Method::Field,
+        Method::Mesh,
+        Method::Triangles,
+        Method::ThinPlate,
+        Method::Mffd,
+        Method::Hybrid,
+        Method::Auto,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Field => "field",
+            Method::Mesh => "mesh",
+            Method::Triangles => "triangles",
+            Method::ThinPlate => "thin-plate",
+            Method::Mffd => "mffd",
+            Method::Hybrid => "hybrid",
+            Method::Auto => "auto",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
+    }
+
+    /// Whether this build can render the method. The others are accepted in
+    /// scenes (so files stay valid) but refuse to render with a clear message.
+    pub fn is_available(self) -> bool {
+        matches!(self, Method::Field)
+    }
+
+    /// Methods that cannot do anything without features (`auto` finds its own
+    /// correspondence, `mesh` takes its own mesh).
+    pub fn needs_features(self) -> bool {
+        !matches!(self, Method::Auto | Method::Mesh)
+    }
+}
+
+/// A feature set at one frame of an image sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Keyframe {
+    pub frame: f64,
+    pub features: Vec<Feature>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    pub method: Method,
+    pub field: FieldSettings,
+    /// Samples per polyline/curve span for point-based methods (seed 000 §4.2).
+    pub samples_per_segment: usize,
+    /// The features when there are no keyframes.
+    pub features: Vec<Feature>,
+    /// Sorted by frame, strictly increasing; when non-empty it replaces `features`.
+    pub keyframes: Vec<Keyframe>,
+    /// `(frame, t)` keys sorted by frame.
+    pub progress: Vec<(f64, f64)>,
+    /// Settings of other methods (`mesh`, `thin-plate`, `transition`, ...) kept
+    /// verbatim so a scene round-trips through tools that do not know them.
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            method: Method::Field,
+            field: FieldSettings::default(),
+            samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
+            features: Vec::new(),
+            keyframes: Vec::new(),
+            progress: Vec::new(),
+            extra: serde_json::Map::new(),
+        }
+    }
+}
+
+impl Scene {
+    /// The features at `frame`: keyframes interpolated linearly in frame and
+    /// held outside the keyed range; the static features without keyframes.
+    pub fn features_at(&self, frame: f64) -> Vec<Feature> {
+        let keys = &self.keyframes;
+        if keys.is_empty() {
+            return self.features.clone();
+        }
+        let (lo, hi, w) = bracket(keys.len(), |i| keys[i].frame, frame);
+        if w == 0.0 {
+            return keys[lo].features.clone();
+        }
+        keys[lo]
+            .features
+            .iter()
+            .zip(&keys[hi].features)
+            .map(|(f0, f1)| Feature {
+                name: f0.name.clone(),
+                kind: f0.kind,
+                a: lerp_points(&f0.a, &f1.a, w),
+                b: lerp_points(&f0.b, &f1.b, w),
+            })
+            .collect()
+    }
+
+    /// Progress `t` at `frame`, if the scene keys it (linear between keys, held outside).
+    pub fn progress_at(&self, frame: f64) -> Option<f64> {
+        let keys = &self.progress;
+        if keys.is_empty() {
+            return None;
+        }
+        let (lo, hi, w) = bracket(keys.len(), |i| keys[i].0, frame);
+        Some(keys[lo].1 + (keys[hi].1 - keys[lo].1) * w)
+    }
+
+    /// Whether the scene has any feature at all (static or keyed).
+    pub fn has_features(&self) -> bool {
+        self.keyframes
+            .first()
+            .map_or(!self.features.is_empty(), |k| !k.features.is_empty())
+    }
+}
+
+/// For sorted keys, the pair of indices around `x` and the weight of the upper one.
+fn bracket(n: usize, key: impl Fn(usize) -> f64, x: f64) -> (usize, usize, f64) {
+    if x <= key(0) {
+        return (0, 0, 0.0);
+    }
+    if x >= key(n - 1) {
+        return (n - 1, n - 1, 0.0);
+    }
+    let hi = (1..n).find(|&i| key(i) > x).unwrap_or(n - 1);
+    let lo = hi - 1;
+    let w = (x - key(lo)) / (key(hi) - key(lo));
+    (lo, hi, w)
+}
+
+fn lerp_points(p0: &[crate::Vec2], p1: &[crate::Vec2], w: f64) -> Vec<crate::Vec2> {
+    p0.iter().zip(p1).map(|(a, b)| a.lerp(*b, w)).collect()
+}

@@ -1,0 +1,374 @@
+//! Reading a scene: serde for the shape, then every rule of CONTRACT §2 with a
+//! message that names the feature or keyframe at fault.
+
+use serde::Deserialize;
+use serde_json::{Map, Value};
+
+use super::{Keyframe, Method, Scene};
+use crate::error::{Error, Result};
+use crate::features::{Feature, FeatureKind};
+use crate::geom::Vec2;
+use crate::warp::field::{Evaluation, FieldSettings, LineInterpolation};
+
+pub const FORMAT: &str = "morphfx-scene";
+
+#[derive(Deserialize)]
+struct RawScene {
+    format: Option<String>,
+    version: Option<u64>,
+    method: Option<String>,
+    field: Option<RawField>,
+    sampling: Option<RawSampling>,
+    features: Option<Vec<RawFeature>>,
+    keyframes: Option<Vec<RawKeyframe>>,
+    progress: Option<Vec<[f64; 2]>>,
+    #[serde(flatten)]
+    extra: Map<String, Value>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawField {
+    a: Option<f64>,
+    b: Option<f64>,
+    p: Option<f64>,
+    interpolation: Option<String>,
+    evaluation: Option<String>,
+    tolerance: Option<f64>,
+    curve_samples: Option<usize>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSampling {
+    samples_per_segment: usize,
+}
+
+#[derive(Deserialize)]
+struct RawFeature {
+    name: Option<String>,
+    #[serde(rename = "type")]
+    kind: String,
+    a: Vec<[f64; 2]>,
+    b: Vec<[f64; 2]>,
+}
+
+#[derive(Deserialize)]
+struct RawKeyframe {
+    frame: f64,
+    features: Vec<RawFeature>,
+}
+
+impl Scene {
+    /// Parse and validate a scene document.
+    pub fn parse(text: &str) -> Result<Scene> {
+        let raw: RawScene = serde_json::from_str(text).map_err(|e| {
+            Error::scene(
+                format!("line {} column {}", e.line(), e.column()),
+                e.to_string(),
+            )
+        })?;
+        if let Some(f) = &raw.format {
+            if f != FORMAT {
+                return Err(Error::scene(
+                    "format",
+                    format!("expected \"{FORMAT}\", found \"{f}\""),
+                ));
+            }
+        }
+        if let Some(v) = raw.version {
+            if v != 1 {
+                return Err(Error::scene(
+                    "version",
+                    format!("version {v} is not supported (this build reads version 1)"),
+                ));
+            }
+        }
+        let method = match &raw.method {
+            None => Method::Field,
+            Some(m) => Method::parse(m).ok_or_else(|| {
+                let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+                Error::scene(
+                    "method",
+                    format!("unknown method \"{m}\" (one of {})", names.join(", ")),
+                )
+            })?,
+        };
+        let field = match raw.field {
+            Some(f) => field_settings(f)?,
+            None => FieldSettings::default(),
+        };
+        let samples_per_segment = match raw.sampling {
+            Some(s) if s.samples_per_segment == 0 || s.samples_per_segment > 1000 => {
+                return Err(Error::scene(
+                    "sampling.samples_per_segment",
+                    "must be between 1 and 1000",
+                ))
+            }
+            Some(s) => s.samples_per_segment,
+            None => crate::features::DEFAULT_SAMPLES_PER_SEGMENT,
+        };
+
+        let features = match raw.features {
+            Some(list) => features(list, "")?,
+            None => Vec::new(),
+        };
+        let keyframes = match raw.keyframes {
+            Some(keys) => keyframes(keys)?,
+            None => Vec::new(),
+        };
+        let progress = match raw.progress {
+            Some(keys) => progress(keys)?,
+            None => Vec::new(),
+        };
+        let scene = Scene {
+            method,
+            field,
+            samples_per_segment,
+            features,
+            keyframes,
+            progress,
+            extra: raw.extra,
+        };
+        if method.needs_features() && !scene.has_features() {
+            return Err(Error::scene(
+                "features",
+                format!(
+                    "method \"{}\" needs at least one feature; the scene has none",
+                    method.name()
+                ),
+            ));
+        }
+        Ok(scene)
+    }
+}
+
+fn field_settings(raw: RawField) -> Result<FieldSettings> {
+    let d = FieldSettings::default();
+    let num =
+        |v: Option<f64>, default: f64, key: &str, ok: fn(f64) -> bool, rule: &str| -> Result<f64> {
+            match v {
+                None => Ok(default),
+                Some(x) if x.is_finite() && ok(x) => Ok(x),
+                Some(x) => Err(Error::scene(
+                    format!("field.{key}"),
+                    format!("{x} is out of range: {rule}"),
+                )),
+            }
+        };
+    let interpolation = match raw.interpolation.as_deref() {
+        None => d.interpolation,
+        Some(s) => LineInterpolation::parse(s).ok_or_else(|| {
+            Error::scene(
+                "field.interpolation",
+                format!("unknown interpolation \"{s}\" (endpoints or center-angle)"),
+            )
+        })?,
+    };
+    let tolerance = num(
+        raw.tolerance,
+        Evaluation::DEFAULT_TOLERANCE,
+        "tolerance",
+        |x| x > 0.0,
+        "must be > 0",
+    )?;
+    let evaluation = match raw.evaluation.as_deref() {
+        None | Some("adaptive") => Evaluation::Adaptive { tolerance },
+        Some("exact") => Evaluation::Exact,
+        Some(s) => {
+            return Err(Error::scene(
+                "field.evaluation",
+                format!("unknown evaluation \"{s}\" (exact or adaptive)"),
+            ))
+        }
+    };
+    let curve_samples = match raw.curve_samples {
+        None => d.curve_samples,
+        Some(n) if (1..=100).contains(&n) => n,
+        Some(n) => {
+            return Err(Error::scene(
+                "field.curve_samples",
+                format!("{n} is out of range: 1 to 100"),
+            ))
+        }
+    };
+    Ok(FieldSettings {
+        a: num(
+            raw.a,
+            d.a,
+            "a",
+            |x| x > 0.0,
+            "a must be > 0 (a = 0 is undefined where lines cross)",
+        )?,
+        b: num(raw.b, d.b, "b", |x| x >= 0.0, "b must be >= 0")?,
+        p: num(raw.p, d.p, "p", |x| x >= 0.0, "p must be >= 0")?,
+        interpolation,
+        evaluation,
+        curve_samples,
+    })
+}
+
+fn features(list: Vec<RawFeature>, prefix: &str) -> Result<Vec<Feature>> {
+    list.into_iter()
+        .enumerate()
+        .map(|(i, raw)| feature(raw, i, prefix))
+        .collect()
+}
+
+fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
+    let at = match &raw.name {
+        Some(n) => format!("{prefix}features[{index}] \"{n}\""),
+        None => format!("{prefix}features[{index}]"),
+    };
+    let kind = FeatureKind::parse(&raw.kind).ok_or_else(|| {
+        Error::scene(
+            &at,
+            format!(
+                "unknown type \"{}\" (point, line, polyline or curve)",
+                raw.kind
+            ),
+        )
+    })?;
+    if raw.a.len() != raw.b.len() {
+        return Err(Error::scene(
+            &at,
+            format!(
+                "a has {} points but b has {}; they must correspond one to one",
+                raw.a.len(),
+                raw.b.len()
+            ),
+        ));
+    }
+    let (min, max) = kind.point_count();
+    let n = raw.a.len();
+    if n < min || n > max {
+        let want = if min == max {
+            format!("exactly {min}")
+        } else {
+            format!("at least {min}")
+        };
+        return Err(Error::scene(
+            &at,
+            format!("a {} needs {want} points, found {n}", kind.name()),
+        ));
+    }
+    let side = |pts: Vec<[f64; 2]>, side: &str| -> Result<Vec<Vec2>> {
+        let pts: Vec<Vec2> = pts.into_iter().map(Vec2::from).collect();
+        if let Some(i) = pts.iter().position(|p| !p.is_finite()) {
+            return Err(Error::scene(
+                &at,
+                format!("{side}[{i}] is not a finite number"),
+            ));
+        }
+        if kind != FeatureKind::Point {
+            if let Some(i) = pts.windows(2).position(|w| w[0] == w[1]) {
+                let what = if kind == FeatureKind::Line {
+                    "the line has zero length"
+                } else {
+                    "two consecutive points coincide"
+                };
+                return Err(Error::scene(
+                    &at,
+                    format!("{side}[{i}] and {side}[{}]: {what}", i + 1),
+                ));
+            }
+        }
+        Ok(pts)
+    };
+    Ok(Feature {
+        name: raw.name.clone(),
+        kind,
+        a: side(raw.a, "a")?,
+        b: side(raw.b, "b")?,
+    })
+}
+
+fn keyframes(raw: Vec<RawKeyframe>) -> Result<Vec<Keyframe>> {
+    let mut keys = Vec::with_capacity(raw.len());
+    for (i, k) in raw.into_iter().enumerate() {
+        let at = format!("keyframes[{i}] (frame {})", k.frame);
+        if !k.frame.is_finite() {
+            return Err(Error::scene(
+                format!("keyframes[{i}]"),
+                "frame is not a finite number",
+            ));
+        }
+        let features = features(k.features, &format!("{at} "))?;
+        if let Some(first) = keys.first() {
+            same_feature_list(first, &features, &at)?;
+        }
+        keys.push(Keyframe {
+            frame: k.frame,
+            features,
+        });
+    }
+    keys.sort_by(|a, b| a.frame.total_cmp(&b.frame));
+    if let Some(w) = keys.windows(2).find(|w| w[0].frame == w[1].frame) {
+        return Err(Error::scene(
+            "keyframes",
+            format!("frame {} is keyed twice", w[0].frame),
+        ));
+    }
+    Ok(keys)
+}
+
+/// Every keyframe must hold the same features in the same order, so that
+/// interpolation between keys pairs like with like.
+fn same_feature_list(first: &Keyframe, features: &[Feature], at: &str) -> Result<()> {
+    let reference = &first.features;
+    if reference.len() != features.len() {
+        return Err(Error::scene(
+            at,
+            format!(
+                "has {} features but keyframe at frame {} has {}; every keyframe must hold the same features",
+                features.len(),
+                first.frame,
+                reference.len()
+            ),
+        ));
+    }
+    for (i, (r, f)) in reference.iter().zip(features).enumerate() {
+        if r.kind != f.kind || r.a.len() != f.a.len() || r.name != f.name {
+            return Err(Error::scene(
+                format!("{at} {}", f.label(i)),
+                format!(
+                    "differs from {} of frame {} ({} with {} points vs {} with {}); every keyframe must hold the same features in the same order",
+                    r.label(i),
+                    first.frame,
+                    f.kind.name(),
+                    f.a.len(),
+                    r.kind.name(),
+                    r.a.len()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn progress(raw: Vec<[f64; 2]>) -> Result<Vec<(f64, f64)>> {
+    let mut keys = Vec::with_capacity(raw.len());
+    for (i, [frame, t]) in raw.into_iter().enumerate() {
+        if !frame.is_finite() || !t.is_finite() {
+            return Err(Error::scene(
+                format!("progress[{i}]"),
+                "frame and t must be finite numbers",
+            ));
+        }
+        if !(0.0..=1.0).contains(&t) {
+            return Err(Error::scene(
+                format!("progress[{i}]"),
+                format!("t = {t} is outside [0, 1]"),
+            ));
+        }
+        keys.push((frame, t));
+    }
+    keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some(w) = keys.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(Error::scene(
+            "progress",
+            format!("frame {} is keyed twice", w[0].0),
+        ));
+    }
+    Ok(keys)
+}

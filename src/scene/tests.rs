@@ -1,0 +1,141 @@
+use super::*;
+use crate::Error;
+
+const GOOD: &str = r#"{
+  "format": "morphfx-scene", "version": 1, "method": "field",
+  "field": { "a": 0.001, "b": 2.0, "p": 0.5, "interpolation": "endpoints" },
+  "features": [
+    { "name": "nose",  "type": "line",     "a": [[410, 300], [412, 220]], "b": [[400, 310], [405, 215]] },
+    { "name": "pupil", "type": "point",    "a": [[350, 380]],             "b": [[344, 390]] },
+    { "name": "jaw",   "type": "polyline", "a": [[300, 200], [380, 120], [460, 200]], "b": [[290, 210], [385, 110], [470, 205]] },
+    { "name": "brow",  "type": "curve",    "a": [[320, 420], [350, 440], [380, 430]], "b": [[315, 425], [350, 450], [385, 432]] }
+  ],
+  "progress": [[1001, 0.0], [1024, 1.0]]
+}"#;
+
+fn err(text: &str) -> (String, String) {
+    match Scene::parse(text) {
+        Err(Error::Scene { at, message }) => (at, message),
+        other => panic!("expected a scene error, got {other:?}"),
+    }
+}
+
+#[test]
+fn parses_the_contract_example() {
+    let s = Scene::parse(GOOD).unwrap();
+    assert_eq!(s.method, Method::Field);
+    assert_eq!(s.features.len(), 4);
+    assert_eq!(s.features[2].a.len(), 3);
+    assert_eq!(s.features[0].name.as_deref(), Some("nose"));
+    assert_eq!(s.progress_at(1001.0), Some(0.0));
+    assert_eq!(s.progress_at(900.0), Some(0.0));
+    assert_eq!(s.progress_at(2000.0), Some(1.0));
+    assert!((s.progress_at(1012.5).unwrap() - 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn keyframes_interpolate_linearly_and_hold_outside() {
+    let s = Scene::parse(
+        r#"{"keyframes": [
+            {"frame": 10, "features": [{"type": "line", "a": [[0,0],[10,0]], "b": [[0,0],[0,10]]}]},
+            {"frame": 20, "features": [{"type": "line", "a": [[10,0],[20,0]], "b": [[4,0],[0,30]]}]}
+        ]}"#,
+    )
+    .unwrap();
+    let f = &s.features_at(12.5)[0];
+    assert_eq!(f.a[0], crate::Vec2::new(2.5, 0.0));
+    assert_eq!(f.b[1], crate::Vec2::new(0.0, 15.0));
+    assert_eq!(s.features_at(0.0)[0].a[0], crate::Vec2::new(0.0, 0.0));
+    assert_eq!(s.features_at(99.0)[0].a[1], crate::Vec2::new(20.0, 0.0));
+}
+
+#[test]
+fn refuses_each_kind_of_bad_scene_naming_the_culprit() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            r#"{"features": [{"name": "eye", "type": "blob", "a": [[0,0]], "b": [[0,0]]}]}"#,
+            "features[0] \"eye\"",
+            "unknown type",
+        ),
+        (
+            r#"{"features": [{"type": "line", "a": [[0,0],[1,1]], "b": [[0,0]]}]}"#,
+            "features[0]",
+            "a has 2 points but b has 1",
+        ),
+        (
+            r#"{"features": [{"type": "line", "a": [[0,0],[1,1],[2,2]], "b": [[0,0],[1,1],[2,2]]}]}"#,
+            "features[0]",
+            "exactly 2",
+        ),
+        (
+            r#"{"features": [{"type": "line", "a": [[5,5],[5,5]], "b": [[0,0],[1,1]]}]}"#,
+            "features[0]",
+            "zero length",
+        ),
+        (
+            r#"{"features": [{"type": "point", "a": [[1e999, 0]], "b": [[0,0]]}]}"#,
+            "line 1",
+            "",
+        ),
+        (
+            r#"{"method": "warpy", "features": []}"#,
+            "method",
+            "unknown method",
+        ),
+        (
+            r#"{"features": []}"#,
+            "features",
+            "needs at least one feature",
+        ),
+        (r#"{"format": "other"}"#, "format", "expected"),
+        (
+            r#"{"field": {"a": 0}, "features": [{"type": "point", "a": [[0,0]], "b": [[1,1]]}]}"#,
+            "field.a",
+            "must be > 0",
+        ),
+        (
+            r#"{"progress": [[1, 1.5]], "features": [{"type": "point", "a": [[0,0]], "b": [[1,1]]}]}"#,
+            "progress[0]",
+            "outside [0, 1]",
+        ),
+        (
+            r#"{"keyframes": [
+                {"frame": 1, "features": [{"name": "n", "type": "line", "a": [[0,0],[1,0]], "b": [[0,0],[1,0]]}]},
+                {"frame": 5, "features": [{"name": "n", "type": "point", "a": [[0,0]], "b": [[0,0]]}]}]}"#,
+            "keyframes[1] (frame 5) features[0] \"n\"",
+            "every keyframe must hold the same features",
+        ),
+        (
+            r#"{"keyframes": [
+                {"frame": 1, "features": [{"type": "point", "a": [[0,0]], "b": [[0,0]]}]},
+                {"frame": 5, "features": []}]}"#,
+            "keyframes[1] (frame 5)",
+            "has 0 features",
+        ),
+        (
+            r#"{"keyframes": [
+                {"frame": 1, "features": [{"type": "point", "a": [[0,0]], "b": [[0,0]]}]},
+                {"frame": 1, "features": [{"type": "point", "a": [[0,0]], "b": [[0,0]]}]}]}"#,
+            "keyframes",
+            "keyed twice",
+        ),
+    ];
+    for (text, at, message) in cases {
+        let (got_at, got_message) = err(text);
+        assert!(
+            got_at.starts_with(at),
+            "{text}: at = {got_at:?}, wanted {at:?}"
+        );
+        assert!(
+            got_message.contains(message),
+            "{text}: message = {got_message:?}, wanted {message:?}"
+        );
+    }
+}
+
+#[test]
+fn unknown_methods_settings_are_kept() {
+    let s = Scene::parse(r#"{"method": "auto", "auto": {"levels": 4}}"#).unwrap();
+    assert_eq!(s.method, Method::Auto);
+    assert!(s.extra.contains_key("auto"));
+}

@@ -1,0 +1,132 @@
+//! What a node can show besides the morph: ST maps, a warped grid with the
+//! features drawn on it, and the transition rate as grey. All are consumers of
+//! the same warp maps as the morph itself.
+
+use crate::features::{sample_points, Feature, FeatureKind};
+use crate::geom::{RectI, Vec2};
+use crate::image::{resample::fill, ImageViewMut, Sample};
+use crate::warp::WarpMap;
+
+/// The output view a node renders (CONTRACT §3 `--view`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum View {
+    #[default]
+    Morph,
+    WarpedA,
+    WarpedB,
+    StmapA,
+    StmapB,
+    Transition,
+    Grid,
+}
+
+impl View {
+    pub const ALL: [View; 7] = [
+        View::Morph,
+        View::WarpedA,
+        View::WarpedB,
+        View::StmapA,
+        View::StmapB,
+        View::Transition,
+        View::Grid,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Morph => "morph",
+            View::WarpedA => "warped-a",
+            View::WarpedB => "warped-b",
+            View::StmapA => "stmap-a",
+            View::StmapB => "stmap-b",
+            View::Transition => "transition",
+            View::Grid => "grid",
+        }
+    }
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|v| v.name() == s)
+    }
+}
+
+/// ST map (Nuke STMap convention, CONTRACT §1): red and green hold the source
+/// position normalised by the source size `source` (canonical, full
+/// resolution), blue 0, alpha 1. Not clamped.
+pub fn stmap<D: Sample>(map: &WarpMap, source: RectI, dst: &mut ImageViewMut<'_, D>) {
+    let (w, h) = (source.width() as f64, source.height() as f64);
+    let (ox, oy) = (source.x1 as f64, source.y1 as f64);
+    fill(dst, 4, |i, j, px| {
+        let win = map.window;
+        if i < win.x1 || i >= win.x2 || j < win.y1 || j >= win.y2 {
+            *px = [0.0; 4];
+            return;
+        }
+        let p = map.get(i, j);
+        *px = [((p.x - ox) / w) as f32, ((p.y - oy) / h) as f32, 0.0, 1.0];
+    });
+}
+
+/// A constant grey of the geometry transition rate (uniform dissolve: `t`).
+pub fn transition_grey<D: Sample>(rate: f64, dst: &mut ImageViewMut<'_, D>) {
+    let r = rate as f32;
+    fill(dst, 4, |_, _, px| *px = [r, r, r, 1.0]);
+}
+
+/// Grid spacing of the grid view, canonical pixels.
+pub const GRID_SPACING: f64 = 32.0;
+
+/// A grid drawn in source space, seen through `map`, with `features` (at the
+/// output's positions) drawn on top in orange: shows where each region of the
+/// source lands and why (seed 002 §4's "ghostbusting" aid).
+pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: &mut ImageViewMut<'_, D>) {
+    let segments: Vec<(Vec2, Vec2)> = features
+        .iter()
+        .flat_map(|f| {
+            let pts = f.points_at(t);
+            let pts = match f.kind {
+                FeatureKind::Curve => sample_points(FeatureKind::Curve, &pts, 8),
+                _ => pts,
+            };
+            if pts.len() == 1 {
+                let p = pts[0];
+                vec![
+                    (p - Vec2::new(3.0, 0.0), p + Vec2::new(3.0, 0.0)),
+                    (p - Vec2::new(0.0, 3.0), p + Vec2::new(0.0, 3.0)),
+                ]
+            } else {
+                pts.windows(2).map(|w| (w[0], w[1])).collect()
+            }
+        })
+        .collect();
+    let scale = map.scale;
+    fill(dst, 4, |i, j, px| {
+        let win = map.window;
+        if i < win.x1 || i >= win.x2 || j < win.y1 || j >= win.y2 {
+            *px = [0.0; 4];
+            return;
+        }
+        let s = map.get(i, j);
+        let near = |v: f64| {
+            let d = (v / GRID_SPACING - (v / GRID_SPACING).round()).abs() * GRID_SPACING;
+            (1.0 - d).max(0.0)
+        };
+        let g = near(s.x).max(near(s.y)) as f32;
+        let base = 0.12 + 0.88 * g;
+        *px = [base, base, base, 1.0];
+        let c = scale.pixel_centre(i, j);
+        let on_feature = segments
+            .iter()
+            .any(|&(p, q)| distance_to_segment(c, p, q) <= 1.0 / scale.y.min(scale.x));
+        if on_feature {
+            *px = [1.0, 0.55, 0.1, 1.0];
+        }
+    });
+}
+
+fn distance_to_segment(x: Vec2, p: Vec2, q: Vec2) -> f64 {
+    let d = q - p;
+    let len2 = d.length_squared();
+    let u = if len2 > 0.0 {
+        ((x - p).dot(d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p + d * u).distance(x)
+}

@@ -1,0 +1,134 @@
+//! The field warp's hot loop: eight points per step across SIMD lanes, lines
+//! laid out as structure-of-arrays so every line constant is one broadcast.
+//! f32 keeps 8 lanes; positions up to 8K stay within ~0.001 px of the f64
+//! reference (tested in `tests.rs`).
+
+use wide::f32x8;
+
+use super::weight::{Exponent, Weight};
+use super::LinePair;
+
+#[derive(Debug, Clone, Default)]
+pub(super) struct Lines {
+    // Destination line P→Q, its direction d and 1/|d|², 1/|d|.
+    px: Vec<f32>,
+    py: Vec<f32>,
+    qx: Vec<f32>,
+    qy: Vec<f32>,
+    dx: Vec<f32>,
+    dy: Vec<f32>,
+    inv_len2: Vec<f32>,
+    inv_len: Vec<f32>,
+    // Source line P' and its direction e' and unit normal n'.
+    spx: Vec<f32>,
+    spy: Vec<f32>,
+    ex: Vec<f32>,
+    ey: Vec<f32>,
+    nx: Vec<f32>,
+    ny: Vec<f32>,
+    /// `length^p` of the destination line.
+    len_p: Vec<f32>,
+    a: f32,
+    exponent: Option<Exponent>,
+}
+
+impl Lines {
+    pub fn new(pairs: &[LinePair], weight: &Weight) -> Self {
+        let mut l = Lines {
+            a: weight.a as f32,
+            exponent: Some(weight.exponent()),
+            ..Default::default()
+        };
+        for pair in pairs {
+            let (p, q) = pair.dst;
+            let (ps, qs) = pair.src;
+            let d = q - p;
+            let e = qs - ps;
+            let n = e.perp() / e.length();
+            l.px.push(p.x as f32);
+            l.py.push(p.y as f32);
+            l.qx.push(q.x as f32);
+            l.qy.push(q.y as f32);
+            l.dx.push(d.x as f32);
+            l.dy.push(d.y as f32);
+            l.inv_len2.push((1.0 / d.length_squared()) as f32);
+            l.inv_len.push((1.0 / d.length()) as f32);
+            l.spx.push(ps.x as f32);
+            l.spy.push(ps.y as f32);
+            l.ex.push(e.x as f32);
+            l.ey.push(e.y as f32);
+            l.nx.push(n.x as f32);
+            l.ny.push(n.y as f32);
+            l.len_p.push(d.length().powf(weight.p) as f32);
+        }
+        l
+    }
+
+    pub fn map_points(&self, xs: &[f32], ys: &[f32], out_x: &mut [f32], out_y: &mut [f32]) {
+        // Dispatch once on the exponent so the inner loop has no branch on it.
+        match self.exponent.unwrap_or(Exponent::One) {
+            Exponent::Zero => self.run(|_| f32x8::ONE, xs, ys, out_x, out_y),
+            Exponent::Half => self.run(|r| r.sqrt(), xs, ys, out_x, out_y),
+            Exponent::One => self.run(|r| r, xs, ys, out_x, out_y),
+            Exponent::Two => self.run(|r| r * r, xs, ys, out_x, out_y),
+            Exponent::General(b) => {
+                let b = f32x8::splat(b);
+                self.run(move |r| (r.ln() * b).exp(), xs, ys, out_x, out_y)
+            }
+        }
+    }
+
+    fn run<F: Fn(f32x8) -> f32x8>(
+        &self,
+        pow: F,
+        xs: &[f32],
+        ys: &[f32],
+        out_x: &mut [f32],
+        out_y: &mut [f32],
+    ) {
+        let n = xs.len();
+        let mut i = 0;
+        while i < n {
+            let take = (n - i).min(8);
+            let mut bx = [0f32; 8];
+            let mut by = [0f32; 8];
+            bx[..take].copy_from_slice(&xs[i..i + take]);
+            by[..take].copy_from_slice(&ys[i..i + take]);
+            let (mx, my) = self.eval8(&pow, f32x8::new(bx), f32x8::new(by));
+            out_x[i..i + take].copy_from_slice(&mx.to_array()[..take]);
+            out_y[i..i + take].copy_from_slice(&my.to_array()[..take]);
+            i += take;
+        }
+    }
+
+    #[inline(always)]
+    fn eval8<F: Fn(f32x8) -> f32x8>(&self, pow: &F, x: f32x8, y: f32x8) -> (f32x8, f32x8) {
+        let zero = f32x8::ZERO;
+        let one = f32x8::ONE;
+        let a = f32x8::splat(self.a);
+        let (mut sx, mut sy, mut ws) = (zero, zero, zero);
+        let s = f32x8::splat;
+        for k in 0..self.px.len() {
+            let rx = x - s(self.px[k]);
+            let ry = y - s(self.py[k]);
+            let (dx, dy) = (s(self.dx[k]), s(self.dy[k]));
+            let u = (rx * dx + ry * dy) * s(self.inv_len2[k]);
+            let v = (ry * dx - rx * dy) * s(self.inv_len[k]);
+            let tx = s(self.spx[k]) + u * s(self.ex[k]) + v * s(self.nx[k]);
+            let ty = s(self.spy[k]) + u * s(self.ey[k]) + v * s(self.ny[k]);
+            let (qx, qy) = (x - s(self.qx[k]), y - s(self.qy[k]));
+            let d2 = u.simd_lt(zero).select(
+                rx * rx + ry * ry,
+                u.simd_gt(one).select(qx * qx + qy * qy, v * v),
+            );
+            let w = pow(s(self.len_p[k]) / (a + d2.sqrt()));
+            sx += (tx - x) * w;
+            sy += (ty - y) * w;
+            ws += w;
+        }
+        // Far from every line a steep falloff can underflow all weights: hold still there.
+        let ok = ws.simd_gt(zero);
+        let inv = ok.select(one / ws, zero);
+        (x + sx * inv, y + sy * inv)
+    }
+}

@@ -1,0 +1,91 @@
+//! Features as Beier-Neely line pairs, and lines interpolated over `t`.
+
+use super::{FieldSettings, LineInterpolation};
+use crate::features::{sample_points, Feature, FeatureKind, Side};
+use crate::geom::Vec2;
+
+/// A directed segment in the output (`dst`) and where it comes from in the
+/// source image (`src`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinePair {
+    pub dst: (Vec2, Vec2),
+    pub src: (Vec2, Vec2),
+}
+
+/// The line pairs that warp the image on `side` toward the features at `t`.
+///
+/// Polylines give one line per segment and curves one per sample interval.
+/// A point becomes a unit-length horizontal line on both sides: with equal
+/// orientation and length the pair is a pure translation by the point's motion,
+/// and its distance term is the distance to the point (within half a pixel).
+pub fn line_pairs_toward(
+    features: &[Feature],
+    side: Side,
+    t: f64,
+    settings: &FieldSettings,
+) -> Vec<LinePair> {
+    let mut pairs = Vec::new();
+    for f in features {
+        let (a, b) = (
+            segments(f, Side::A, settings),
+            segments(f, Side::B, settings),
+        );
+        for (sa, sb) in a.into_iter().zip(b) {
+            let dst = interpolate_line(sa, sb, t, settings.interpolation);
+            let src = match side {
+                Side::A => sa,
+                Side::B => sb,
+            };
+            // Degenerate sampled segments carry no direction; skip them.
+            if dst.0 != dst.1 && src.0 != src.1 {
+                pairs.push(LinePair { dst, src });
+            }
+        }
+    }
+    pairs
+}
+
+fn segments(f: &Feature, side: Side, settings: &FieldSettings) -> Vec<(Vec2, Vec2)> {
+    let pts = f.points(side);
+    match f.kind {
+        FeatureKind::Point => vec![(pts[0], pts[0] + Vec2::new(1.0, 0.0))],
+        FeatureKind::Line | FeatureKind::Polyline => pts.windows(2).map(|w| (w[0], w[1])).collect(),
+        FeatureKind::Curve => sample_points(FeatureKind::Curve, pts, settings.curve_samples)
+            .windows(2)
+            .map(|w| (w[0], w[1]))
+            .collect(),
+    }
+}
+
+/// The line at `t` between its A position `a` and its B position `b`.
+/// `t = 0` and `t = 1` return `a` and `b` bit for bit, so the end frames are
+/// identity warps.
+pub fn interpolate_line(
+    a: (Vec2, Vec2),
+    b: (Vec2, Vec2),
+    t: f64,
+    mode: LineInterpolation,
+) -> (Vec2, Vec2) {
+    if t == 0.0 {
+        return a;
+    }
+    if t == 1.0 {
+        return b;
+    }
+    match mode {
+        LineInterpolation::Endpoints => (a.0.lerp(b.0, t), a.1.lerp(b.1, t)),
+        LineInterpolation::CenterAngle => {
+            let (ca, cb) = ((a.0 + a.1) * 0.5, (b.0 + b.1) * 0.5);
+            let (da, db) = (a.1 - a.0, b.1 - b.0);
+            let (ta, tb) = (da.y.atan2(da.x), db.y.atan2(db.x));
+            // Turn the short way round.
+            let mut turn = tb - ta;
+            turn -= (turn / std::f64::consts::TAU).round() * std::f64::consts::TAU;
+            let angle = ta + turn * t;
+            let len = da.length() + (db.length() - da.length()) * t;
+            let c = ca.lerp(cb, t);
+            let half = Vec2::new(angle.cos(), angle.sin()) * (len * 0.5);
+            (c - half, c + half)
+        }
+    }
+}

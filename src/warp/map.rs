@@ -1,0 +1,64 @@
+//! A warp evaluated at pixel centres: what resampling and the ST-map view consume,
+//! and what the plugin caches between tiles and threads.
+
+use crate::geom::{PixelScale, RectI, Vec2};
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct WarpMap {
+    /// Output pixels covered, at `scale`.
+    pub window: RectI,
+    pub scale: PixelScale,
+    /// Canonical source position per output pixel, rows bottom-up. Empty when
+    /// `identity` (then every pixel samples its own centre).
+    positions: Vec<[f32; 2]>,
+    identity: bool,
+}
+
+impl WarpMap {
+    pub fn new(window: RectI, scale: PixelScale, positions: Vec<[f32; 2]>) -> Self {
+        assert_eq!(positions.len(), window.area(), "one position per pixel");
+        WarpMap {
+            window,
+            scale,
+            positions,
+            identity: false,
+        }
+    }
+
+    pub fn identity(window: RectI, scale: PixelScale) -> Self {
+        WarpMap {
+            window,
+            scale,
+            positions: Vec::new(),
+            identity: true,
+        }
+    }
+
+    pub fn is_identity(&self) -> bool {
+        self.identity
+    }
+
+    /// Canonical source position for output pixel `(i, j)` (inside `window`).
+    pub fn get(&self, i: i32, j: i32) -> Vec2 {
+        if self.identity {
+            return self.scale.pixel_centre(i, j);
+        }
+        let k = (j - self.window.y1) as usize * self.window.width() + (i - self.window.x1) as usize;
+        let [x, y] = self.positions[k];
+        Vec2::new(x as f64, y as f64)
+    }
+
+    /// One row of positions (`None` for the identity map).
+    pub fn row(&self, j: i32) -> Option<&[[f32; 2]]> {
+        if self.identity {
+            return None;
+        }
+        let w = self.window.width();
+        let start = (j - self.window.y1) as usize * w;
+        Some(&self.positions[start..start + w])
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        self.positions.len() * std::mem::size_of::<[f32; 2]>()
+    }
+}
