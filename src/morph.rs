@@ -1,7 +1,7 @@
 //! The in-between image: both sources warped toward the same feature positions
 //! and dissolved (seed 002 §3.4).
 
-use crate::image::{resample::adapt_channels, resample::fill, ImageViewMut, Sample, Sampler};
+use crate::image::{resample::adapt_channels, resample::fill, RowsMut, Sample, Sampler};
 use crate::warp::WarpMap;
 
 /// `dst = (1 − t) · A(map_a) + t · B(map_b)`, in `dst`'s channel layout.
@@ -13,9 +13,9 @@ pub fn dissolve<S: Sample, D: Sample>(
     b: &Sampler<'_, S>,
     map_b: &WarpMap,
     t: f64,
-    dst: &mut ImageViewMut<'_, D>,
+    dst: RowsMut<'_, D>,
 ) {
-    let dc = dst.channels();
+    let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
     let (ca, cb) = (a.channels(), b.channels());
     fill(dst, dc, |i, j, px| {

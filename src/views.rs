@@ -3,8 +3,8 @@
 //! the same warp maps as the morph itself.
 
 use crate::features::{sample_points, Feature, FeatureKind};
-use crate::geom::{RectI, Vec2};
-use crate::image::{resample::fill, ImageViewMut, Sample};
+use crate::geom::Vec2;
+use crate::image::{resample::fill, RowsMut, Sample};
 use crate::warp::WarpMap;
 
 /// The output view a node renders (CONTRACT §3 `--view`).
@@ -47,11 +47,11 @@ impl View {
 }
 
 /// ST map (Nuke STMap convention, CONTRACT §1): red and green hold the source
-/// position normalised by the source size `source` (canonical, full
-/// resolution), blue 0, alpha 1. Not clamped.
-pub fn stmap<D: Sample>(map: &WarpMap, source: RectI, dst: &mut ImageViewMut<'_, D>) {
-    let (w, h) = (source.width() as f64, source.height() as f64);
-    let (ox, oy) = (source.x1 as f64, source.y1 as f64);
+/// position normalised by the source image's extent (`origin`, `size`:
+/// canonical, full resolution), blue 0, alpha 1. Not clamped.
+pub fn stmap<D: Sample>(map: &WarpMap, origin: Vec2, size: Vec2, dst: RowsMut<'_, D>) {
+    let (w, h) = (size.x, size.y);
+    let (ox, oy) = (origin.x, origin.y);
     fill(dst, 4, |i, j, px| {
         let win = map.window;
         if i < win.x1 || i >= win.x2 || j < win.y1 || j >= win.y2 {
@@ -64,7 +64,7 @@ pub fn stmap<D: Sample>(map: &WarpMap, source: RectI, dst: &mut ImageViewMut<'_,
 }
 
 /// A constant grey of the geometry transition rate (uniform dissolve: `t`).
-pub fn transition_grey<D: Sample>(rate: f64, dst: &mut ImageViewMut<'_, D>) {
+pub fn transition_grey<D: Sample>(rate: f64, dst: RowsMut<'_, D>) {
     let r = rate as f32;
     fill(dst, 4, |_, _, px| *px = [r, r, r, 1.0]);
 }
@@ -75,7 +75,7 @@ pub const GRID_SPACING: f64 = 32.0;
 /// A grid drawn in source space, seen through `map`, with `features` (at the
 /// output's positions) drawn on top in orange: shows where each region of the
 /// source lands and why (seed 002 §4's "ghostbusting" aid).
-pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: &mut ImageViewMut<'_, D>) {
+pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: RowsMut<'_, D>) {
     let segments: Vec<(Vec2, Vec2)> = features
         .iter()
         .flat_map(|f| {

@@ -165,6 +165,15 @@ impl<'a, T: Sample> ImageViewMut<'a, T> {
             layout: self.layout,
         }
     }
+    /// The view as disjoint rows, ready to be written in parallel.
+    pub fn rows(&mut self) -> RowsMut<'_, T> {
+        RowsMut {
+            bounds: self.layout.bounds,
+            channels: self.layout.channels,
+            rows: self.rows_mut(),
+        }
+    }
+
     /// Every row as its own mutable slice, `(j, row)`, so rows can be written
     /// in parallel whatever the stride's sign.
     pub fn rows_mut(&mut self) -> Vec<(i32, &mut [T])> {
@@ -186,6 +195,16 @@ impl<'a, T: Sample> ImageViewMut<'a, T> {
         }
         rows
     }
+}
+
+/// Output pixels as disjoint rows: row `j` holds pixels `x1..x2` of `bounds`.
+/// Hosts may render tiles of one buffer on several threads, so writers get
+/// only the rows (and columns) of their own window, never the whole buffer.
+#[derive(Debug)]
+pub struct RowsMut<'a, T> {
+    pub bounds: RectI,
+    pub channels: usize,
+    pub rows: Vec<(i32, &'a mut [T])>,
 }
 
 /// An owned float image: packed rows, bottom row first.

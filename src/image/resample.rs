@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::{EdgeMode, Filter, ImageView, ImageViewMut, Sample, Sampler};
+use super::{EdgeMode, Filter, ImageView, RowsMut, Sample, Sampler};
 use crate::geom::PixelScale;
 use crate::warp::WarpMap;
 
@@ -22,12 +22,12 @@ const PARALLEL_MIN_PIXELS: usize = 16 * 1024;
 /// stores `px` converted to `dst`'s channel layout and sample type. `px` holds
 /// the value in `src_channels` layout (1 = alpha, 3 = RGB, 4 = RGBA).
 pub fn fill<D: Sample>(
-    dst: &mut ImageViewMut<'_, D>,
+    dst: RowsMut<'_, D>,
     src_channels: usize,
     f: impl Fn(i32, i32, &mut [f32; 4]) + Sync,
 ) {
-    let b = dst.bounds();
-    let dc = dst.channels();
+    let b = dst.bounds;
+    let dc = dst.channels;
     let work = |(j, row): (i32, &mut [D])| {
         let mut px = [0f32; 4];
         for (k, out) in row.chunks_exact_mut(dc).enumerate() {
@@ -38,7 +38,7 @@ pub fn fill<D: Sample>(
             }
         }
     };
-    let rows = dst.rows_mut();
+    let rows = dst.rows;
     if b.area() >= PARALLEL_MIN_PIXELS {
         rows.into_par_iter().for_each(work);
     } else {
@@ -67,7 +67,7 @@ pub fn resample<S: Sample, D: Sample>(
     src: ImageView<'_, S>,
     src_scale: PixelScale,
     map: &WarpMap,
-    dst: &mut ImageViewMut<'_, D>,
+    dst: RowsMut<'_, D>,
     settings: ResampleSettings,
 ) {
     let sampler = Sampler::new(
@@ -77,8 +77,13 @@ pub fn resample<S: Sample, D: Sample>(
         settings.edge,
         settings.premultiplied,
     );
-    fill(dst, src.channels(), |i, j, px| {
-        sample_through(&sampler, map, i, j, px);
+    through(&sampler, map, dst);
+}
+
+/// `dst(i, j) = sampler(map(i, j))`.
+pub fn through<S: Sample, D: Sample>(sampler: &Sampler<'_, S>, map: &WarpMap, dst: RowsMut<'_, D>) {
+    fill(dst, sampler.channels(), |i, j, px| {
+        sample_through(sampler, map, i, j, px);
     });
 }
 

@@ -39,7 +39,7 @@ fn render(t: f64, features: &[Feature]) -> Image {
         true,
     );
     let mut out = Image::new(a.bounds, 4);
-    dissolve(&sa, &wa, &sb, &wb, t, &mut out.view_mut());
+    dissolve(&sa, &wa, &sb, &wb, t, out.view_mut().rows());
     out
 }
 

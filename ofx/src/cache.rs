@@ -1,0 +1,169 @@
+//! Warps cached in instance data (DESIGN rule 6): keyed by everything a map
+//! depends on, shared by concurrent renders of the same frame (the second
+//! thread waits for the first instead of computing again), bounded in memory.
+
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+use std::sync::{Arc, Mutex};
+
+use morphfx::warp::WarpMap;
+
+/// Default memory budget for cached maps (a 1080p map is 16 MiB).
+pub const DEFAULT_BUDGET_BYTES: usize = 512 << 20;
+
+type Slot = Arc<Mutex<Option<Arc<WarpMap>>>>;
+
+struct Entry {
+    key: u64,
+    slot: Slot,
+    bytes: usize,
+    last_use: u64,
+}
+
+pub struct WarpCache {
+    entries: Mutex<(Vec<Entry>, u64)>,
+    budget: usize,
+}
+
+impl Default for WarpCache {
+    fn default() -> Self {
+        WarpCache::new(DEFAULT_BUDGET_BYTES)
+    }
+}
+
+/// A cache key from anything whose `Debug` form names all it depends on
+/// (floats print exactly, so equal text means equal inputs).
+pub fn key_of(parts: &impl std::fmt::Debug) -> u64 {
+    let mut h = DefaultHasher::new();
+    format!("{parts:?}").hash(&mut h);
+    h.finish()
+}
+
+impl WarpCache {
+    pub fn new(budget: usize) -> Self {
+        WarpCache {
+            entries: Mutex::new((Vec::new(), 0)),
+            budget,
+        }
+    }
+
+    pub fn get_or_compute<E>(
+        &self,
+        key: u64,
+        compute: impl FnOnce() -> Result<WarpMap, E>,
+    ) -> Result<Arc<WarpMap>, E> {
+        let slot = {
+            let mut guard = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+            let (entries, clock) = &mut *guard;
+            *clock += 1;
+            match entries.iter_mut().find(|e| e.key == key) {
+                Some(e) => {
+                    e.last_use = *clock;
+                    e.slot.clone()
+                }
+                None => {
+                    let slot: Slot = Arc::default();
+                    entries.push(Entry {
+                        key,
+                        slot: slot.clone(),
+                        bytes: 0,
+                        last_use: *clock,
+                    });
+                    slot
+                }
+            }
+        };
+        // Per-entry lock: threads wanting the same map wait here for one computation.
+        let mut value = slot.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(map) = value.as_ref() {
+            return Ok(map.clone());
+        }
+        let map = Arc::new(compute()?);
+        *value = Some(map.clone());
+        drop(value);
+        self.account(key, map.memory_bytes());
+        Ok(map)
+    }
+
+    fn account(&self, key: u64, bytes: usize) {
+        let mut guard = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        let (entries, _) = &mut *guard;
+        if let Some(e) = entries.iter_mut().find(|e| e.key == key) {
+            e.bytes = bytes;
+        }
+        // Evict least recently used entries (never the one just made) over budget.
+        while entries.iter().map(|e| e.bytes).sum::<usize>() > self.budget && entries.len() > 1 {
+            let Some((i, _)) = entries
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.key != key)
+                .min_by_key(|(_, e)| e.last_use)
+            else {
+                break;
+            };
+            entries.swap_remove(i);
+        }
+    }
+
+    pub fn clear(&self) {
+        self.entries
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .0
+            .clear();
+    }
+
+    #[cfg(test)]
+    pub fn bytes(&self) -> usize {
+        self.entries
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .0
+            .iter()
+            .map(|e| e.bytes)
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use morphfx::geom::{PixelScale, RectI};
+
+    fn map(w: usize) -> WarpMap {
+        WarpMap::new(
+            RectI::from_size(w, 1),
+            PixelScale::UNIT,
+            vec![[0.0, 0.0]; w],
+        )
+    }
+
+    #[test]
+    fn computes_once_per_key_even_across_threads() {
+        let cache = WarpCache::default();
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        std::thread::scope(|s| {
+            for _ in 0..8 {
+                s.spawn(|| {
+                    cache
+                        .get_or_compute::<()>(42, || {
+                            calls.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                            std::thread::sleep(std::time::Duration::from_millis(20));
+                            Ok(map(4))
+                        })
+                        .unwrap();
+                });
+            }
+        });
+        assert_eq!(calls.load(std::sync::atomic::Ordering::SeqCst), 1);
+    }
+
+    #[test]
+    fn stays_within_its_budget() {
+        let cache = WarpCache::new(100 * 8);
+        for k in 0..10 {
+            cache.get_or_compute::<()>(k, || Ok(map(40))).unwrap();
+        }
+        assert!(cache.bytes() <= 100 * 8);
+    }
+}

@@ -1,0 +1,46 @@
+//! Per-instance state: the warp cache, the parsed scene, messages said once.
+
+use std::collections::HashSet;
+use std::sync::{Arc, Mutex};
+
+use morphfx::scene::Scene;
+
+use crate::cache::WarpCache;
+use crate::wrapper::clips::Effect;
+use crate::wrapper::{dispatch, Outcome};
+
+#[derive(Default)]
+pub struct Instance {
+    pub warps: WarpCache,
+    /// The last scene parsed, keyed by where it came from (text, or path + mtime + size).
+    pub scene: Mutex<Option<(String, Arc<Scene>)>>,
+    /// Warnings already posted (minimal hosts: report each fallback once).
+    pub said: Mutex<HashSet<String>>,
+}
+
+impl Instance {
+    pub fn purge(&self) {
+        self.warps.clear();
+        *self.scene.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    }
+
+    /// True the first time `what` is asked about.
+    pub fn first_time(&self, what: &str) -> bool {
+        self.said
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(what.to_owned())
+    }
+}
+
+pub fn create(effect: &Effect) -> Outcome {
+    dispatch::attach_instance(effect, Arc::new(Instance::default()))
+}
+
+pub fn destroy(effect: &Effect) -> Outcome {
+    dispatch::detach_instance(effect)
+}
+
+pub fn get(effect: &Effect) -> Outcome<Arc<Instance>> {
+    dispatch::instance(effect)
+}

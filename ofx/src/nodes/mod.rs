@@ -1,0 +1,172 @@
+//! The nodes, in safe Rust: what each declares (clips, params, capabilities)
+//! and what each does per action. All host access goes through `wrapper`.
+
+mod instance;
+pub mod morph;
+pub mod params;
+mod render;
+pub mod spec;
+pub mod warp;
+
+use std::ffi::CStr;
+
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::image_effect::*;
+
+use crate::wrapper::clips::Effect;
+use crate::wrapper::props::PropSet;
+use crate::wrapper::{params as host_params, Failure, Outcome};
+pub use instance::Instance;
+
+pub const PLUGIN_VERSION: (u32, u32) = (1, 0);
+pub const PLUGIN_IDS: [&str; 2] = [morph::INFO.id, warp::INFO.id];
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum NodeKind {
+    Morph,
+    Warp,
+}
+
+pub struct NodeInfo {
+    pub id: &'static str,
+    pub label: &'static str,
+    pub description: &'static str,
+    pub contexts: &'static [&'static CStr],
+}
+
+impl NodeKind {
+    pub const ALL: [NodeKind; 2] = [NodeKind::Morph, NodeKind::Warp];
+
+    pub fn info(self) -> &'static NodeInfo {
+        match self {
+            NodeKind::Morph => &morph::INFO,
+            NodeKind::Warp => &warp::INFO,
+        }
+    }
+
+    /// The source clips in `context`: (A, B) for Morph, (Source, none) for Warp.
+    pub fn source_clips(self, context: &str) -> (&'static str, Option<&'static str>) {
+        match self {
+            NodeKind::Morph => {
+                let [a, b] = morph::source_clips(context);
+                (a, Some(b))
+            }
+            NodeKind::Warp => (warp::SOURCE_CLIP, None),
+        }
+    }
+}
+
+fn is(action: &CStr, name: &CStr) -> bool {
+    action == name
+}
+
+/// Runs one action. `Ok(kOfxStatReplyDefault)` for actions we leave to the host.
+pub fn action(
+    kind: NodeKind,
+    action: &CStr,
+    effect: Option<Effect>,
+    in_args: OfxPropertySetHandle,
+    out_args: OfxPropertySetHandle,
+) -> Outcome<OfxStatus> {
+    if is(action, kOfxActionLoad) || is(action, kOfxActionUnload) {
+        return Ok(kOfxStatOK);
+    }
+    let effect = effect.ok_or_else(|| {
+        Failure::Status(
+            kOfxStatErrBadHandle,
+            format!("{} without an effect handle", action.to_string_lossy()),
+        )
+    })?;
+    let in_props = || PropSet::new(in_args);
+    let out_props = || PropSet::new(out_args);
+    if is(action, kOfxActionDescribe) {
+        describe(kind, &effect)?;
+    } else if is(action, kOfxImageEffectActionDescribeInContext) {
+        let context = in_props()?.get_string(kOfxImageEffectPropContext, 0)?;
+        describe_in_context(kind, &effect, &context)?;
+    } else if is(action, kOfxActionCreateInstance) {
+        instance::create(&effect)?;
+    } else if is(action, kOfxActionDestroyInstance) {
+        instance::destroy(&effect)?;
+    } else if is(action, kOfxActionPurgeCaches) {
+        instance::get(&effect)?.purge();
+    } else if is(action, kOfxImageEffectActionGetRegionOfDefinition) {
+        render::region_of_definition(kind, &effect, &in_props()?, &out_props()?)?;
+    } else if is(action, kOfxImageEffectActionGetRegionsOfInterest) {
+        render::regions_of_interest(kind, &effect, &out_props()?)?;
+    } else if is(action, kOfxImageEffectActionGetFramesNeeded) {
+        render::frames_needed(kind, &effect, &in_props()?, &out_props()?)?;
+    } else if is(action, kOfxImageEffectActionRender) {
+        render::render(kind, &effect, &in_props()?)?;
+    } else {
+        return Ok(kOfxStatReplyDefault);
+    }
+    Ok(kOfxStatOK)
+}
+
+fn describe(kind: NodeKind, effect: &Effect) -> Outcome {
+    let info = kind.info();
+    let p = effect.props()?;
+    p.set_string(kOfxPropLabel, 0, info.label)?;
+    let _ = p.set_string(kOfxPropShortLabel, 0, info.label);
+    let _ = p.set_string(kOfxPropPluginDescription, 0, info.description);
+    p.set_string(kOfxImageEffectPluginPropGrouping, 0, "MorphFX")?;
+    let contexts: Vec<String> = info
+        .contexts
+        .iter()
+        .map(|c| c.to_string_lossy().into_owned())
+        .collect();
+    p.set_strings(
+        kOfxImageEffectPropSupportedContexts,
+        &contexts.iter().map(String::as_str).collect::<Vec<_>>(),
+    )?;
+    p.set_strings(
+        kOfxImageEffectPropSupportedPixelDepths,
+        &["OfxBitDepthByte", "OfxBitDepthShort", "OfxBitDepthFloat"],
+    )?;
+    // Capabilities: optional for a host to honour, so failures to set them are not fatal.
+    let _ = p.set_int(kOfxImageEffectPluginPropSingleInstance, 0, 0);
+    let _ = p.set_string(
+        kOfxImageEffectPluginRenderThreadSafety,
+        0,
+        &kOfxImageEffectRenderFullySafe.to_string_lossy(),
+    );
+    // We split the window across threads ourselves (rayon), so the host need not.
+    let _ = p.set_int(kOfxImageEffectPluginPropHostFrameThreading, 0, 0);
+    let _ = p.set_int(kOfxImageEffectPropSupportsTiles, 0, 1);
+    let _ = p.set_int(kOfxImageEffectPropSupportsMultiResolution, 0, 1);
+    let _ = p.set_int(kOfxImageEffectPropTemporalClipAccess, 0, 1);
+    let _ = p.set_int(kOfxImageEffectPropSupportsMultipleClipDepths, 0, 0);
+    let _ = p.set_int(kOfxImageEffectPropSupportsMultipleClipPARs, 0, 0);
+    let _ = p.set_int(kOfxImageEffectPluginPropFieldRenderTwiceAlways, 0, 0);
+    Ok(())
+}
+
+fn describe_in_context(kind: NodeKind, effect: &Effect, context: &str) -> Outcome {
+    let (a, b) = kind.source_clips(context);
+    for name in std::iter::once(a).chain(b) {
+        let clip = effect.define_clip(name)?;
+        clip.set_strings(
+            kOfxImageEffectPropSupportedComponents,
+            &[
+                "OfxImageComponentRGBA",
+                "OfxImageComponentRGB",
+                "OfxImageComponentAlpha",
+            ],
+        )?;
+        let _ = clip.set_int(kOfxImageEffectPropSupportsTiles, 0, 1);
+        let _ = clip.set_int(kOfxImageEffectPropTemporalClipAccess, 0, 1);
+        let _ = clip.set_int(kOfxImageClipPropOptional, 0, 0);
+    }
+    let out = effect.define_clip("Output")?;
+    out.set_strings(
+        kOfxImageEffectPropSupportedComponents,
+        &[
+            "OfxImageComponentRGBA",
+            "OfxImageComponentRGB",
+            "OfxImageComponentAlpha",
+        ],
+    )?;
+    let _ = out.set_int(kOfxImageEffectPropSupportsTiles, 0, 1);
+    host_params::define_all(effect.param_set()?, &params::table(kind))
+}

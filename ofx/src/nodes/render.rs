@@ -1,0 +1,392 @@
+//! Render glue: host images in, core calls, host image out. Conversions to
+//! pixel rows, render scale and pixel aspect happen here, once (DESIGN rule 3).
+
+use std::sync::Arc;
+
+use morphfx::features::{Feature, Side};
+use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::image::resample::through;
+use morphfx::image::{ImageView, RowsMut, Sample, Sampler};
+use morphfx::morph::dissolve;
+use morphfx::scene::Scene;
+use morphfx::views::{self, View};
+use morphfx::warp::{self, WarpMap, WarpSettings};
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::message::*;
+
+use super::instance::{self, Instance};
+use super::params::{Settings, OFFSET_A, OFFSET_B};
+use super::NodeKind;
+use crate::cache::key_of;
+use crate::wrapper::clips::{Clip, Depth, Effect, HostImage};
+use crate::wrapper::props::PropSet;
+use crate::wrapper::{Failure, Outcome};
+
+const TRANSITION: &str = "OfxImageEffectContextTransition";
+
+fn context(effect: &Effect) -> String {
+    effect
+        .props()
+        .and_then(|p| p.get_string(kOfxImageEffectPropContext, 0))
+        .unwrap_or_default()
+}
+
+/// The frame offsets of the sources (params read without a settings pass).
+fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
+    let Ok(params) = effect.params() else {
+        return (0.0, 0.0);
+    };
+    let a = params.int(OFFSET_A, time).unwrap_or(0) as f64;
+    let b = if kind == NodeKind::Morph {
+        params.int(OFFSET_B, time).unwrap_or(0) as f64
+    } else {
+        0.0
+    };
+    (a, b)
+}
+
+/// The clip whose frame the output takes: A, else B when only B is connected.
+fn format_clip(kind: NodeKind, effect: &Effect, context: &str) -> Outcome<(Clip, f64)> {
+    let (a, b) = kind.source_clips(context);
+    let clip_a = effect.clip(a)?;
+    if !clip_a.is_connected() {
+        if let Some(b) = b {
+            let clip_b = effect.clip(b)?;
+            if clip_b.is_connected() {
+                return Ok((clip_b, 1.0));
+            }
+        }
+    }
+    Ok((clip_a, 0.0))
+}
+
+pub fn region_of_definition(
+    kind: NodeKind,
+    effect: &Effect,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let context = context(effect);
+    let (clip, which) = format_clip(kind, effect, &context)?;
+    let (oa, ob) = offsets(kind, effect, time);
+    let rod = clip.rod(time + if which == 0.0 { oa } else { ob })?;
+    out_args.set_doubles(
+        kOfxImageEffectPropRegionOfDefinition,
+        &[rod.x1, rod.y1, rod.x2, rod.y2],
+    )
+}
+
+/// A warp can pull from anywhere: ask for each source's whole region.
+pub fn regions_of_interest(kind: NodeKind, effect: &Effect, out_args: &PropSet) -> Outcome {
+    let context = context(effect);
+    let (a, b) = kind.source_clips(&context);
+    for name in std::iter::once(a).chain(b) {
+        let clip = effect.clip(name)?;
+        if !clip.is_connected() {
+            continue;
+        }
+        // The RoI is time independent here; use the clip's RoD at time 0's
+        // neighbourhood through the host (any time gives the plate's extent).
+        if let Ok(rod) = clip.rod(0.0) {
+            let prop =
+                std::ffi::CString::new(format!("OfxImageClipPropRoI_{name}")).unwrap_or_default();
+            out_args.set_doubles(&prop, &[rod.x1, rod.y1, rod.x2, rod.y2])?;
+        }
+    }
+    Ok(())
+}
+
+pub fn frames_needed(
+    kind: NodeKind,
+    effect: &Effect,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let (oa, ob) = offsets(kind, effect, time);
+    let context = context(effect);
+    let (a, b) = kind.source_clips(&context);
+    for (name, off) in std::iter::once((a, oa)).chain(b.map(|b| (b, ob))) {
+        let prop = std::ffi::CString::new(format!("OfxImageClipPropFrameRange_{name}"))
+            .unwrap_or_default();
+        out_args.set_doubles(&prop, &[time + off, time + off])?;
+    }
+    Ok(())
+}
+
+/// The scene named by the params, parsed once per content.
+fn load_scene(instance: &Instance, settings: &Settings) -> Outcome<Option<Arc<Scene>>> {
+    let path = settings.scene_file.trim();
+    let (key, source) = if !path.is_empty() {
+        let meta = std::fs::metadata(path)
+            .map_err(|e| Failure::BadInput(format!("scene file {path}: {e}")))?;
+        (
+            format!("file:{path}:{:?}:{}", meta.modified().ok(), meta.len()),
+            Some(path),
+        )
+    } else if !settings.scene_text.trim().is_empty() {
+        (format!("text:{}", settings.scene_text), None)
+    } else {
+        return Ok(None);
+    };
+    let mut cached = instance.scene.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((k, scene)) = cached.as_ref() {
+        if *k == key {
+            return Ok(Some(scene.clone()));
+        }
+    }
+    let text = match source {
+        Some(path) => std::fs::read_to_string(path)
+            .map_err(|e| Failure::BadInput(format!("scene file {path}: {e}")))?,
+        None => settings.scene_text.clone(),
+    };
+    let scene = Scene::parse(&text).map_err(|e| match source {
+        Some(path) => Failure::BadInput(format!("scene file {path}: {e}")),
+        None => Failure::BadInput(format!("scene text: {e}")),
+    })?;
+    let scene = Arc::new(scene);
+    *cached = Some((key, scene.clone()));
+    Ok(Some(scene))
+}
+
+/// Everything the frame's warps depend on.
+#[derive(Debug)]
+struct Frame {
+    features: Vec<Feature>,
+    warp: WarpSettings,
+    t: f64,
+}
+
+fn frame_at(
+    kind: NodeKind,
+    effect: &Effect,
+    instance: &Instance,
+    settings: &Settings,
+    time: f64,
+    context: &str,
+) -> Outcome<Frame> {
+    let scene = load_scene(instance, settings)?;
+    let mut features = settings.lines.clone();
+    let mut warp = WarpSettings {
+        method: settings.method,
+        field: settings.field,
+        ..WarpSettings::default()
+    };
+    let mut t = settings.progress;
+    if let Some(scene) = &scene {
+        features.extend(scene.features_at(time));
+        if settings.settings_from_scene {
+            warp = WarpSettings::from(&**scene);
+        }
+        if settings.use_scene_progress {
+            t = scene.progress_at(time).unwrap_or(t);
+        }
+    }
+    if kind == NodeKind::Morph && context == TRANSITION {
+        let transition = kOfxImageEffectTransitionParamName.to_string_lossy();
+        t = effect.params()?.double(&transition, time)?.clamp(0.0, 1.0);
+    }
+    Ok(Frame { features, warp, t })
+}
+
+fn source(effect: &Effect, name: &str, time: f64) -> Outcome<HostImage> {
+    let clip = effect.clip(name)?;
+    if !clip.is_connected() {
+        return Err(Failure::BadInput(format!("clip {name} is not connected")));
+    }
+    clip.image(time)?
+        .ok_or_else(|| Failure::BadInput(format!("clip {name} has no image at frame {time}")))
+}
+
+pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
+    let window = RectI::new(x1, y1, x2, y2);
+    let instance = instance::get(effect)?;
+    let context = context(effect);
+    let settings = Settings::read(&effect.params()?, time, kind);
+    if !settings.missing.is_empty() && instance.first_time("missing params") {
+        effect.message(
+            kOfxMessageWarning,
+            c"net.morphfx.MissingParams",
+            &format!(
+                "the host could not read these params; their defaults are used: {}",
+                settings.missing.join(", ")
+            ),
+        );
+    }
+    let frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
+    if !frame.warp.method.is_available() {
+        return Err(Failure::BadInput(format!(
+            "method \"{}\" is not available in this build yet (available: field)",
+            frame.warp.method.name()
+        )));
+    }
+
+    let (a_name, b_name) = kind.source_clips(&context);
+    let a_img = source(effect, a_name, time + settings.offset_a as f64)?;
+    let b_img = match b_name {
+        Some(b) => Some(source(effect, b, time + settings.offset_b as f64)?),
+        None => None,
+    };
+    let mut out_img = effect
+        .clip("Output")?
+        .image(time)?
+        .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
+    let out_info = out_img.info()?;
+    let a_info = a_img.info()?;
+    let b_info = b_img.as_ref().map(|b| b.info()).transpose()?;
+
+    let scale = PixelScale::new(
+        out_info.render_scale.0,
+        out_info.render_scale.1,
+        out_info.par,
+    );
+    // Maps cover the whole output frame so tiles of one frame share one cached map.
+    let (format_clip, _) = format_clip(kind, effect, &context)?;
+    let rod = format_clip.rod(time)?;
+    let full = RectI::new(
+        (rod.x1 * scale.x).floor() as i32,
+        (rod.y1 * scale.y).floor() as i32,
+        (rod.x2 * scale.x).ceil() as i32,
+        (rod.y2 * scale.y).ceil() as i32,
+    );
+    let map_window = if full.contains(&window) { full } else { window };
+    let map = |side: Side| -> Outcome<Arc<WarpMap>> {
+        let key = key_of(&(&frame, side, map_window, scale.x, scale.y));
+        instance.warps.get_or_compute(key, || {
+            let w = warp::toward(&frame.features, side, frame.t, &frame.warp)?;
+            Ok::<_, Failure>(w.map_window(map_window, scale))
+        })
+    };
+    if effect.aborted() {
+        return Ok(());
+    }
+    let (origin, size) = project(effect, &rod);
+    let job = Job {
+        view: settings.view,
+        t: frame.t,
+        features: &frame.features,
+        map_a: if needs_a(settings.view) {
+            Some(map(Side::A)?)
+        } else {
+            None
+        },
+        map_b: if needs_b(kind, settings.view) {
+            Some(map(Side::B)?)
+        } else {
+            None
+        },
+        origin,
+        size,
+    };
+    let a_scale = PixelScale::new(a_info.render_scale.0, a_info.render_scale.1, a_info.par);
+    let b_scale = b_info.map(|b| PixelScale::new(b.render_scale.0, b.render_scale.1, b.par));
+
+    macro_rules! with_depth {
+        ($depth:expr, $T:ident => $body:expr) => {
+            match $depth {
+                Depth::U8 => {
+                    type $T = u8;
+                    $body
+                }
+                Depth::U16 => {
+                    type $T = u16;
+                    $body
+                }
+                Depth::F32 => {
+                    type $T = f32;
+                    $body
+                }
+            }
+        };
+    }
+    with_depth!(out_info.depth, D => {
+        let rows = out_img.rows_mut::<D>(&out_info, window)?;
+        with_depth!(a_info.depth, S => {
+            let a_view = a_img.view::<S>(&a_info)?;
+            let a = Sampler::new(a_view, a_scale, settings.filter, settings.edge, a_info.premultiplied);
+            match (&b_img, b_info) {
+                (Some(b_img), Some(b_info)) => {
+                    if b_info.depth != a_info.depth {
+                        return Err(Failure::BadInput("Source A and Source B have different bit depths".into()));
+                    }
+                    let b_view: ImageView<'_, S> = b_img.view::<S>(&b_info)?;
+                    let b = Sampler::new(b_view, b_scale.unwrap_or(a_scale), settings.filter, settings.edge, b_info.premultiplied);
+                    job.draw(&a, Some(&b), rows);
+                }
+                _ => job.draw(&a, None, rows),
+            }
+        })
+    });
+    Ok(())
+}
+
+fn needs_a(view: View) -> bool {
+    matches!(
+        view,
+        View::Morph | View::WarpedA | View::StmapA | View::Grid
+    )
+}
+
+fn needs_b(kind: NodeKind, view: View) -> bool {
+    kind == NodeKind::Morph && matches!(view, View::Morph | View::WarpedB | View::StmapB)
+}
+
+/// The image extent ST maps are normalised by: the project (format) when the
+/// host says, else the source's region of definition.
+fn project(effect: &Effect, rod: &OfxRectD) -> (Vec2, Vec2) {
+    let from_host = effect.props().ok().and_then(|p| {
+        let size = p.get_doubles::<2>(kOfxImageEffectPropProjectExtent).ok()?;
+        let origin = p
+            .get_doubles::<2>(kOfxImageEffectPropProjectOffset)
+            .unwrap_or([0.0, 0.0]);
+        (size[0] > 0.0 && size[1] > 0.0).then(|| {
+            (
+                Vec2::new(origin[0], origin[1]),
+                Vec2::new(size[0] - origin[0], size[1] - origin[1]),
+            )
+        })
+    });
+    from_host.unwrap_or((
+        Vec2::new(rod.x1, rod.y1),
+        Vec2::new(rod.x2 - rod.x1, rod.y2 - rod.y1),
+    ))
+}
+
+struct Job<'a> {
+    view: View,
+    t: f64,
+    features: &'a [Feature],
+    map_a: Option<Arc<WarpMap>>,
+    map_b: Option<Arc<WarpMap>>,
+    origin: Vec2,
+    size: Vec2,
+}
+
+impl Job<'_> {
+    fn draw<S: Sample, D: Sample>(
+        &self,
+        a: &Sampler<'_, S>,
+        b: Option<&Sampler<'_, S>>,
+        rows: RowsMut<'_, D>,
+    ) {
+        let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
+        match (self.view, b) {
+            (View::Morph, Some(b)) => {
+                dissolve(a, ma.expect("map A"), b, mb.expect("map B"), self.t, rows)
+            }
+            (View::Morph | View::WarpedA, _) => through(a, ma.expect("map A"), rows),
+            (View::WarpedB, Some(b)) => through(b, mb.expect("map B"), rows),
+            (View::StmapA, _) => views::stmap(ma.expect("map A"), self.origin, self.size, rows),
+            (View::StmapB, _) => {
+                views::stmap(mb.or(ma).expect("map"), self.origin, self.size, rows)
+            }
+            (View::Transition, _) => views::transition_grey(self.t, rows),
+            (View::Grid, _) => views::grid(ma.expect("map A"), self.features, self.t, rows),
+            (View::WarpedB, None) => through(a, ma.expect("map A"), rows),
+        }
+    }
+}

@@ -1,0 +1,125 @@
+//! The one door every action comes through: null checks, unwinds caught,
+//! failures reported through the message suite and mapped to OFX statuses.
+
+use std::ffi::{c_char, c_void, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Arc;
+
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::message::*;
+
+use super::clips::Effect;
+use super::{Failure, Outcome, BAD_INPUT_ID};
+use crate::nodes::{self, Instance, NodeKind};
+
+/// Test hook: `MORPHFX_FORCE_PANIC=<action name>` makes that action panic, so
+/// tests can prove that no unwind crosses the C ABI.
+const FORCE_PANIC: &str = "MORPHFX_FORCE_PANIC";
+
+pub fn dispatch(
+    kind: NodeKind,
+    action: *const c_char,
+    handle: *const c_void,
+    in_args: OfxPropertySetHandle,
+    out_args: OfxPropertySetHandle,
+) -> OfxStatus {
+    if action.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    // SAFETY: the host passes a NUL-terminated action name (checked non-null).
+    let action = unsafe { CStr::from_ptr(action) };
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        if std::env::var(FORCE_PANIC).is_ok_and(|a| a.as_bytes() == action.to_bytes()) {
+            panic!(
+                "forced panic in {} ({FORCE_PANIC})",
+                action.to_string_lossy()
+            );
+        }
+        let effect = if handle.is_null() {
+            None
+        } else {
+            Some(Effect::new(handle)?)
+        };
+        nodes::action(kind, action, effect, in_args, out_args)
+    }));
+    match result {
+        Ok(Ok(status)) => status,
+        Ok(Err(failure)) => {
+            report(handle, action, &failure);
+            failure.status()
+        }
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("unknown panic");
+            let failure = Failure::Failed(format!(
+                "internal error in {}: {what}",
+                action.to_string_lossy()
+            ));
+            // Reporting must not unwind either.
+            let _ = catch_unwind(AssertUnwindSafe(|| report(handle, action, &failure)));
+            kOfxStatFailed
+        }
+    }
+}
+
+fn report(handle: *const c_void, action: &CStr, failure: &Failure) {
+    let id = match failure {
+        Failure::BadInput(_) => BAD_INPUT_ID,
+        _ => c"net.morphfx.Error",
+    };
+    let text = failure.message();
+    match Effect::new(handle) {
+        Ok(effect) if !handle.is_null() => effect.error(id, text),
+        _ => eprintln!("MorphFX: {}: {text}", action.to_string_lossy()),
+    }
+    let _ = kOfxMessageError;
+}
+
+/// Stores `instance` in the effect's instance data (created in createInstance).
+pub fn attach_instance(effect: &Effect, instance: Arc<Instance>) -> Outcome {
+    let raw = Arc::into_raw(instance) as *mut c_void;
+    effect
+        .props()?
+        .set_pointer(kOfxPropInstanceData, 0, raw)
+        .inspect_err(|_| {
+            // SAFETY: `raw` came from Arc::into_raw just above and was not stored.
+            drop(unsafe { Arc::from_raw(raw as *const Instance) });
+        })
+}
+
+/// Takes the instance data back and drops our reference (destroyInstance).
+pub fn detach_instance(effect: &Effect) -> Outcome {
+    let props = effect.props()?;
+    let raw = props.get_pointer(kOfxPropInstanceData, 0)?;
+    if raw.is_null() {
+        return Ok(());
+    }
+    props.set_pointer(kOfxPropInstanceData, 0, std::ptr::null_mut())?;
+    // SAFETY: a non-null instance pointer is only ever one made by
+    // `attach_instance` from Arc::into_raw; it is cleared above so this is its
+    // only release. Renders still running hold their own clones.
+    drop(unsafe { Arc::from_raw(raw as *const Instance) });
+    Ok(())
+}
+
+/// The instance's state, as a reference-counted handle that stays valid even
+/// if the host destroys the instance while this call runs.
+pub fn instance(effect: &Effect) -> Outcome<Arc<Instance>> {
+    let raw = effect.props()?.get_pointer(kOfxPropInstanceData, 0)?;
+    if raw.is_null() {
+        return Err(Failure::Failed(
+            "instance has no data: createInstance was not called".into(),
+        ));
+    }
+    let raw = raw as *const Instance;
+    // SAFETY: `raw` came from Arc::into_raw in `attach_instance` and the
+    // attachment's count is still held (it is cleared before release), so
+    // taking one more strong count and materialising it is sound.
+    unsafe {
+        Arc::increment_strong_count(raw);
+        Ok(Arc::from_raw(raw))
+    }
+}

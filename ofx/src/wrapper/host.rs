@@ -1,0 +1,83 @@
+//! The host's suites, fetched once in `OfxSetHost` and shared by all threads.
+
+use std::ffi::CStr;
+use std::sync::RwLock;
+
+use openfx::sys::generic::core::*;
+use openfx::sys::generic::property::*;
+use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::message::*;
+use openfx::sys::image_effect_v1::param::*;
+
+use super::{Failure, Outcome};
+
+#[derive(Clone, Copy)]
+pub struct Suites {
+    pub prop: &'static OfxPropertySuiteV1,
+    pub effect: &'static OfxImageEffectSuiteV1,
+    pub param: &'static OfxParameterSuiteV1,
+    pub message: Option<&'static OfxMessageSuiteV1>,
+}
+
+// SAFETY: the suites are immutable function tables the host keeps alive for as
+// long as the binary is loaded; OFX allows calling them from any thread that
+// the host calls us on (the suites we use are documented thread safe for
+// render-time use, or we only use them on the threads the spec allows).
+unsafe impl Send for Suites {}
+unsafe impl Sync for Suites {}
+
+static SUITES: RwLock<Option<Suites>> = RwLock::new(None);
+
+/// Fetches the suites from `host`. Called from `OfxSetHost`.
+pub fn set_host(host: *mut OfxHost) -> Outcome {
+    if host.is_null() {
+        return Err(Failure::Failed("OfxSetHost was given a null host".into()));
+    }
+    // SAFETY: non-null, and the host promises the struct outlives the binary's use of it.
+    let host = unsafe { &*host };
+    let fetch = host
+        .fetchSuite
+        .ok_or_else(|| Failure::Failed("host has no fetchSuite".into()))?;
+    let get = |name: &CStr, version: i32| -> *const std::ffi::c_void {
+        // SAFETY: fetchSuite is the host's own function, called as OFX specifies.
+        unsafe { fetch(host.host, name.as_ptr(), version) }
+    };
+    let required = |name: &CStr, version: i32| -> Outcome<*const std::ffi::c_void> {
+        let p = get(name, version);
+        if p.is_null() {
+            Err(Failure::Status(
+                kOfxStatErrMissingHostFeature,
+                format!(
+                    "host does not provide suite {} v{version}",
+                    name.to_string_lossy()
+                ),
+            ))
+        } else {
+            Ok(p)
+        }
+    };
+    let prop = required(kOfxPropertySuite, 1)? as *const OfxPropertySuiteV1;
+    let effect = required(kOfxImageEffectSuite, 1)? as *const OfxImageEffectSuiteV1;
+    let param = required(kOfxParameterSuite, 1)? as *const OfxParameterSuiteV1;
+    let message = get(kOfxMessageSuite, 1) as *const OfxMessageSuiteV1;
+    // SAFETY: the host returned these pointers for the named suite versions;
+    // they stay valid until the binary is unloaded.
+    let suites = unsafe {
+        Suites {
+            prop: &*prop,
+            effect: &*effect,
+            param: &*param,
+            message: message.as_ref(),
+        }
+    };
+    // A later OfxSetHost (a host that reloads us) replaces the suites.
+    *SUITES.write().unwrap_or_else(|e| e.into_inner()) = Some(suites);
+    Ok(())
+}
+
+pub fn suites() -> Outcome<Suites> {
+    SUITES
+        .read()
+        .unwrap_or_else(|e| e.into_inner())
+        .ok_or_else(|| Failure::Failed("the host never called OfxSetHost".into()))
+}

@@ -1,0 +1,68 @@
+//! All FFI of the plugin. Each `unsafe` block states why it is sound; every
+//! entry point goes through [`dispatch`], which null-checks, catches unwinds and
+//! maps errors to OFX statuses (DESIGN rule 5).
+
+pub mod clips;
+pub mod dispatch;
+mod exports;
+pub mod host;
+pub mod params;
+pub mod props;
+
+use std::ffi::CStr;
+
+use openfx::sys::generic::core::*;
+
+/// Why an action did not succeed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Failure {
+    /// The user's input cannot be rendered (bad scene, missing clip, ...):
+    /// reported through the message suite with id [`BAD_INPUT_ID`].
+    BadInput(String),
+    /// Something else went wrong; reported as an error message.
+    Failed(String),
+    /// A host call answered this status.
+    Status(OfxStatus, String),
+}
+
+/// Message id under which bad-input errors are posted, so a host (our harness)
+/// can tell the user's mistakes from internal failures.
+pub const BAD_INPUT_ID: &CStr = c"net.morphfx.BadInput";
+
+pub type Outcome<T = ()> = Result<T, Failure>;
+
+impl From<morphfx::Error> for Failure {
+    fn from(e: morphfx::Error) -> Self {
+        match e {
+            morphfx::Error::Unsupported(_)
+            | morphfx::Error::Scene { .. }
+            | morphfx::Error::Invalid(_) => Failure::BadInput(e.to_string()),
+        }
+    }
+}
+
+impl Failure {
+    pub fn status(&self) -> OfxStatus {
+        match self {
+            Failure::BadInput(_) | Failure::Failed(_) => kOfxStatFailed,
+            Failure::Status(s, _) => *s,
+        }
+    }
+    pub fn message(&self) -> &str {
+        match self {
+            Failure::BadInput(m) | Failure::Failed(m) | Failure::Status(_, m) => m,
+        }
+    }
+}
+
+/// Turns a host status into a result, naming the call that produced it.
+pub fn check(status: OfxStatus, what: &str) -> Outcome {
+    if status == kOfxStatOK {
+        Ok(())
+    } else {
+        Err(Failure::Status(
+            status,
+            format!("{what} failed with OFX status {status}"),
+        ))
+    }
+}

@@ -1,0 +1,226 @@
+//! Defining params from [`ParamSpec`] tables and reading their values.
+
+use std::ffi::{c_char, c_int, CStr, CString};
+
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::param::*;
+
+use super::props::PropSet;
+use super::{check, host, Failure, Outcome};
+use crate::nodes::spec::{Kind, ParamSpec, TextMode};
+
+fn cstr(s: &str) -> CString {
+    CString::new(s).unwrap_or_default()
+}
+
+/// Defines every param of `specs` on `param_set` (describe-in-context).
+pub fn define_all(param_set: OfxParamSetHandle, specs: &[ParamSpec]) -> Outcome {
+    for spec in specs {
+        define(param_set, spec)?;
+    }
+    Ok(())
+}
+
+fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
+    let suite = host::suites()?.param;
+    let define = suite
+        .paramDefine
+        .ok_or_else(|| Failure::Failed("host has no paramDefine".into()))?;
+    let kind: &CStr = match &spec.kind {
+        Kind::Double { .. } => kOfxParamTypeDouble,
+        Kind::Int { .. } => kOfxParamTypeInteger,
+        Kind::Bool { .. } => kOfxParamTypeBoolean,
+        Kind::Choice { .. } => kOfxParamTypeChoice,
+        Kind::Point { .. } => kOfxParamTypeDouble2D,
+        Kind::Text { .. } => kOfxParamTypeString,
+        Kind::Group { .. } => kOfxParamTypeGroup,
+    };
+    let name = cstr(&spec.id);
+    let mut props: OfxPropertySetHandle = std::ptr::null_mut();
+    // SAFETY: param_set came from the host's getParamSet for this descriptor;
+    // type and name are NUL-terminated; `props` is a live out-pointer.
+    let status = unsafe { define(param_set, kind.as_ptr(), name.as_ptr(), &mut props) };
+    check(status, &format!("defining param {}", spec.id))?;
+    let p = PropSet::new(props)?;
+    p.set_string(kOfxPropLabel, 0, &spec.label)?;
+    // Optional properties: a minimal host may not know them; defining still succeeds.
+    let _ = p.set_string(kOfxParamPropHint, 0, &spec.hint);
+    let _ = p.set_string(kOfxParamPropScriptName, 0, &spec.id);
+    if let Some(g) = spec.group {
+        let _ = p.set_string(kOfxParamPropParent, 0, g);
+    }
+    if !matches!(spec.kind, Kind::Group { .. }) {
+        let _ = p.set_int(kOfxParamPropAnimates, 0, spec.animates as i32);
+    }
+    match &spec.kind {
+        Kind::Double {
+            default,
+            min,
+            max,
+            display,
+        } => {
+            p.set_double(kOfxParamPropDefault, 0, *default)?;
+            let _ = p.set_double(kOfxParamPropMin, 0, *min);
+            let _ = p.set_double(kOfxParamPropMax, 0, *max);
+            // Both range and display range set: Resolve otherwise clamps to (-1, 1).
+            let _ = p.set_double(kOfxParamPropDisplayMin, 0, display.0);
+            let _ = p.set_double(kOfxParamPropDisplayMax, 0, display.1);
+            let _ = p.set_string(
+                kOfxParamPropDoubleType,
+                0,
+                &kOfxParamDoubleTypePlain.to_string_lossy(),
+            );
+        }
+        Kind::Int { default, min, max } => {
+            p.set_int(kOfxParamPropDefault, 0, *default)?;
+            let _ = p.set_int(kOfxParamPropMin, 0, *min);
+            let _ = p.set_int(kOfxParamPropMax, 0, *max);
+            let _ = p.set_int(kOfxParamPropDisplayMin, 0, *min);
+            let _ = p.set_int(kOfxParamPropDisplayMax, 0, *max);
+        }
+        Kind::Bool { default } => p.set_int(kOfxParamPropDefault, 0, *default as i32)?,
+        Kind::Choice { options, default } => {
+            p.set_strings(kOfxParamPropChoiceOption, options)?;
+            p.set_int(kOfxParamPropDefault, 0, *default as i32)?;
+        }
+        Kind::Point { default } => {
+            p.set_doubles(kOfxParamPropDefault, &[default.0, default.1])?;
+            let _ = p.set_string(
+                kOfxParamPropDoubleType,
+                0,
+                &kOfxParamDoubleTypeXYAbsolute.to_string_lossy(),
+            );
+            // Defaults and values in canonical pixels, not normalised (OFX 1.2+).
+            let _ = p.set_string(
+                kOfxParamPropDefaultCoordinateSystem,
+                0,
+                &kOfxParamCoordinatesCanonical.to_string_lossy(),
+            );
+        }
+        Kind::Text { default, mode } => {
+            p.set_string(kOfxParamPropDefault, 0, default)?;
+            let mode: &CStr = match mode {
+                TextMode::MultiLine => kOfxParamStringIsMultiLine,
+                TextMode::FilePath => kOfxParamStringIsFilePath,
+            };
+            let _ = p.set_string(kOfxParamPropStringMode, 0, &mode.to_string_lossy());
+            if matches!(
+                spec.kind,
+                Kind::Text {
+                    mode: TextMode::FilePath,
+                    ..
+                }
+            ) {
+                let _ = p.set_int(kOfxParamPropStringFilePathExists, 0, 1);
+            }
+        }
+        Kind::Group { open } => {
+            let _ = p.set_int(kOfxParamPropGroupOpen, 0, *open as i32);
+        }
+    }
+    Ok(())
+}
+
+/// Reads param values of one instance.
+#[derive(Clone, Copy)]
+pub struct Params {
+    set: OfxParamSetHandle,
+    suite: &'static OfxParameterSuiteV1,
+}
+
+impl Params {
+    pub fn new(set: OfxParamSetHandle) -> Outcome<Self> {
+        if set.is_null() {
+            return Err(Failure::Status(
+                kOfxStatErrBadHandle,
+                "null param set".into(),
+            ));
+        }
+        Ok(Params {
+            set,
+            suite: host::suites()?.param,
+        })
+    }
+
+    fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
+        let get = self
+            .suite
+            .paramGetHandle
+            .ok_or_else(|| Failure::Failed("host has no paramGetHandle".into()))?;
+        let name = cstr(id);
+        let mut h: OfxParamHandle = std::ptr::null_mut();
+        // SAFETY: set is the instance's param set; name NUL-terminated; out-pointer live.
+        let status = unsafe { get(self.set, name.as_ptr(), &mut h, std::ptr::null_mut()) };
+        check(status, &format!("param {id}"))?;
+        if h.is_null() {
+            return Err(Failure::Status(
+                kOfxStatErrBadHandle,
+                format!("param {id}: null handle"),
+            ));
+        }
+        Ok(h)
+    }
+
+    fn get_at(
+        &self,
+        id: &str,
+    ) -> Outcome<(
+        OfxParamHandle,
+        unsafe extern "C" fn(OfxParamHandle, OfxTime, ...) -> OfxStatus,
+    )> {
+        let f = self
+            .suite
+            .paramGetValueAtTime
+            .ok_or_else(|| Failure::Failed("host has no paramGetValueAtTime".into()))?;
+        Ok((self.handle(id)?, f))
+    }
+
+    pub fn double(&self, id: &str, time: f64) -> Outcome<f64> {
+        let (h, f) = self.get_at(id)?;
+        let mut v = 0.0f64;
+        // SAFETY: a Double param takes one `double*` vararg (OFX param suite).
+        check(
+            unsafe { f(h, time, &mut v as *mut f64) },
+            &format!("reading {id}"),
+        )?;
+        Ok(v)
+    }
+
+    /// Integer, boolean and choice params all take one `int*`.
+    pub fn int(&self, id: &str, time: f64) -> Outcome<i32> {
+        let (h, f) = self.get_at(id)?;
+        let mut v: c_int = 0;
+        // SAFETY: Integer, Boolean and Choice params take one `int*` vararg.
+        check(
+            unsafe { f(h, time, &mut v as *mut c_int) },
+            &format!("reading {id}"),
+        )?;
+        Ok(v)
+    }
+
+    pub fn point(&self, id: &str, time: f64) -> Outcome<(f64, f64)> {
+        let (h, f) = self.get_at(id)?;
+        let (mut x, mut y) = (0.0f64, 0.0f64);
+        // SAFETY: a Double2D param takes two `double*` varargs.
+        check(
+            unsafe { f(h, time, &mut x as *mut f64, &mut y as *mut f64) },
+            &format!("reading {id}"),
+        )?;
+        Ok((x, y))
+    }
+
+    pub fn string(&self, id: &str, time: f64) -> Outcome<String> {
+        let (h, f) = self.get_at(id)?;
+        let mut v: *const c_char = std::ptr::null();
+        // SAFETY: a String param takes one `char**` vararg; the host owns the result.
+        check(
+            unsafe { f(h, time, &mut v as *mut *const c_char) },
+            &format!("reading {id}"),
+        )?;
+        if v.is_null() {
+            return Ok(String::new());
+        }
+        // SAFETY: NUL-terminated host string, valid until the next param call; copied now.
+        Ok(unsafe { CStr::from_ptr(v) }.to_string_lossy().into_owned())
+    }
+}
