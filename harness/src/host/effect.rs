@@ -1,0 +1,434 @@
+//! Effects (descriptors and instances), clips backed by frame buffers, images,
+//! and the image effect and message suites.
+
+use std::collections::HashSet;
+use std::ffi::{c_char, c_int, c_void, CStr};
+use std::sync::{Arc, Mutex};
+
+use morphfx::geom::RectI;
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::message::*;
+use openfx::sys::image_effect_v1::param::*;
+
+use super::frame::Frame;
+use super::params::ParamSet;
+use super::props::PropertySet;
+
+/// Supplies a clip's frames.
+pub trait FrameSource: Send + Sync {
+    /// The frame at `time` at render scale 1, or why there is none.
+    fn frame(&self, time: f64) -> Result<Arc<Frame>, String>;
+}
+
+pub struct Clip {
+    pub name: String,
+    pub props: PropertySet,
+    pub source: Mutex<Option<Arc<dyn FrameSource>>>,
+    /// The buffer renders write into (output clip).
+    pub output: Mutex<Option<Arc<Frame>>>,
+    effect: *const Effect,
+}
+
+// SAFETY: `effect` points at the owning Effect, which outlives its clips and is
+// itself shared between threads only through its own locks.
+unsafe impl Send for Clip {}
+unsafe impl Sync for Clip {}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Message {
+    pub kind: String,
+    pub id: String,
+    pub text: String,
+}
+
+pub struct Effect {
+    pub props: PropertySet,
+    pub params: ParamSet,
+    pub clips: Mutex<Vec<Box<Clip>>>,
+    pub messages: Mutex<Vec<Message>>,
+    /// (render scale x, y) of the render in progress.
+    pub render_scale: Mutex<(f64, f64)>,
+}
+
+static LIVE_EFFECTS: Mutex<Option<HashSet<usize>>> = Mutex::new(None);
+
+impl Effect {
+    pub fn new() -> Box<Effect> {
+        let e = Box::new(Effect {
+            props: PropertySet::new(),
+            params: ParamSet::default(),
+            clips: Mutex::new(Vec::new()),
+            messages: Mutex::new(Vec::new()),
+            render_scale: Mutex::new((1.0, 1.0)),
+        });
+        LIVE_EFFECTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get_or_insert_with(HashSet::new)
+            .insert(&*e as *const Effect as usize);
+        e
+    }
+
+    pub fn handle(&self) -> OfxImageEffectHandle {
+        self as *const Effect as OfxImageEffectHandle
+    }
+
+    pub fn clip(&self, name: &str) -> Option<&Clip> {
+        let clips = self.clips.lock().unwrap_or_else(|e| e.into_inner());
+        // SAFETY: clips are boxed and never removed while the effect lives.
+        clips
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| unsafe { &*(&**c as *const Clip) })
+    }
+
+    pub fn clip_names(&self) -> Vec<String> {
+        self.clips
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .map(|c| c.name.clone())
+            .collect()
+    }
+
+    pub fn add_clip(&self, name: &str, props: PropertySet) -> &Clip {
+        let clip = Box::new(Clip {
+            name: name.to_owned(),
+            props,
+            source: Mutex::new(None),
+            output: Mutex::new(None),
+            effect: self,
+        });
+        clip.props.set_str(kOfxPropName, name);
+        let mut clips = self.clips.lock().unwrap_or_else(|e| e.into_inner());
+        clips.push(clip);
+        // SAFETY: just pushed a box that lives as long as the effect.
+        unsafe { &*(&**clips.last().expect("pushed") as *const Clip) }
+    }
+
+    pub fn take_messages(&self) -> Vec<Message> {
+        std::mem::take(&mut *self.messages.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+}
+
+impl Drop for Effect {
+    fn drop(&mut self) {
+        if let Some(set) = LIVE_EFFECTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .as_mut()
+        {
+            set.remove(&(self as *const Effect as usize));
+        }
+    }
+}
+
+fn live_effect<'a>(h: *const c_void) -> Option<&'a Effect> {
+    let live = LIVE_EFFECTS.lock().unwrap_or_else(|e| e.into_inner());
+    if live.as_ref().is_some_and(|s| s.contains(&(h as usize))) {
+        // SAFETY: registered effects are live boxes (removed on drop).
+        Some(unsafe { &*(h as *const Effect) })
+    } else {
+        None
+    }
+}
+
+unsafe fn clip_of<'a>(h: OfxImageClipHandle) -> Option<&'a Clip> {
+    // SAFETY: clip handles we hand out point at boxed Clips of a live effect.
+    unsafe { (h as *const Clip).as_ref() }
+}
+
+unsafe extern "C" fn get_property_set(
+    h: OfxImageEffectHandle,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    let Some(e) = live_effect(h as *const c_void) else {
+        return kOfxStatErrBadHandle;
+    };
+    if !props.is_null() {
+        unsafe { *props = e.props.handle() };
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn get_param_set(
+    h: OfxImageEffectHandle,
+    set: *mut OfxParamSetHandle,
+) -> OfxStatus {
+    let Some(e) = live_effect(h as *const c_void) else {
+        return kOfxStatErrBadHandle;
+    };
+    if !set.is_null() {
+        unsafe { *set = &e.params as *const ParamSet as OfxParamSetHandle };
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn clip_define(
+    h: OfxImageEffectHandle,
+    name: *const c_char,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    let Some(e) = live_effect(h as *const c_void) else {
+        return kOfxStatErrBadHandle;
+    };
+    if name.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    // SAFETY: NUL-terminated name from the plugin.
+    let name = unsafe { CStr::from_ptr(name) }
+        .to_string_lossy()
+        .into_owned();
+    let clip = match e.clip(&name) {
+        Some(c) => c,
+        None => e.add_clip(&name, PropertySet::new()),
+    };
+    if !props.is_null() {
+        unsafe { *props = clip.props.handle() };
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn clip_get_handle(
+    h: OfxImageEffectHandle,
+    name: *const c_char,
+    clip: *mut OfxImageClipHandle,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    let Some(e) = live_effect(h as *const c_void) else {
+        return kOfxStatErrBadHandle;
+    };
+    if name.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    // SAFETY: NUL-terminated name from the plugin.
+    let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
+    let Some(c) = e.clip(&name) else {
+        return kOfxStatErrUnknown;
+    };
+    unsafe {
+        if !clip.is_null() {
+            *clip = c as *const Clip as OfxImageClipHandle;
+        }
+        if !props.is_null() {
+            *props = c.props.handle();
+        }
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn clip_get_property_set(
+    clip: OfxImageClipHandle,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    let Some(c) = (unsafe { clip_of(clip) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if !props.is_null() {
+        unsafe { *props = c.props.handle() };
+    }
+    kOfxStatOK
+}
+
+impl Clip {
+    fn effect(&self) -> &Effect {
+        // SAFETY: a clip never outlives its effect.
+        unsafe { &*self.effect }
+    }
+
+    /// The frame this clip shows at `time` and the render scale in force.
+    pub fn frame_at(&self, time: f64) -> Result<Option<Arc<Frame>>, String> {
+        if let Some(out) = self
+            .output
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+        {
+            return Ok(Some(out));
+        }
+        let source = self
+            .source
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        let Some(source) = source else {
+            return Ok(None);
+        };
+        let frame = source.frame(time)?;
+        let scale = *self
+            .effect()
+            .render_scale
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        Ok(Some(if scale == (1.0, 1.0) {
+            frame
+        } else {
+            Arc::new(frame.scaled(scale))
+        }))
+    }
+
+    /// Canonical region of definition at `time` (the full-resolution bounds).
+    pub fn rod(&self, time: f64) -> Option<RectI> {
+        let source = self
+            .source
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()?;
+        source.frame(time).ok().map(|f| f.bounds)
+    }
+}
+
+unsafe extern "C" fn clip_get_image(
+    clip: OfxImageClipHandle,
+    time: OfxTime,
+    _region: *const OfxRectD,
+    image: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    let Some(c) = (unsafe { clip_of(clip) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if image.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    let frame = match c.frame_at(time) {
+        Ok(Some(f)) => f,
+        Ok(None) => return kOfxStatFailed,
+        Err(message) => {
+            c.effect()
+                .messages
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(Message {
+                    kind: "OfxMessageError".into(),
+                    id: "net.morphfx.harness.MissingFrame".into(),
+                    text: message,
+                });
+            return kOfxStatFailed;
+        }
+    };
+    let scale = *c
+        .effect()
+        .render_scale
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    let props = frame.image_props(scale, time);
+    // SAFETY: out-pointer from the plugin. The boxed set (owning the frame) is
+    // released by clipReleaseImage.
+    unsafe { *image = Box::into_raw(Box::new(props)) as OfxPropertySetHandle };
+    kOfxStatOK
+}
+
+unsafe extern "C" fn clip_release_image(image: OfxPropertySetHandle) -> OfxStatus {
+    if image.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    // SAFETY: image handles come only from Box::into_raw in clip_get_image,
+    // and a plugin releases each once.
+    drop(unsafe { Box::from_raw(image as *mut PropertySet) });
+    kOfxStatOK
+}
+
+unsafe extern "C" fn clip_get_rod(
+    clip: OfxImageClipHandle,
+    time: OfxTime,
+    bounds: *mut OfxRectD,
+) -> OfxStatus {
+    let Some(c) = (unsafe { clip_of(clip) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    let Some(r) = c.rod(time) else {
+        return kOfxStatFailed;
+    };
+    if !bounds.is_null() {
+        unsafe {
+            *bounds = OfxRectD {
+                x1: r.x1 as f64,
+                y1: r.y1 as f64,
+                x2: r.x2 as f64,
+                y2: r.y2 as f64,
+            };
+        }
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn abort(_: OfxImageEffectHandle) -> c_int {
+    0
+}
+
+unsafe extern "C" fn memory_alloc(
+    _: OfxImageEffectHandle,
+    _: usize,
+    _: *mut OfxImageMemoryHandle,
+) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn memory_free(_: OfxImageMemoryHandle) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn memory_lock(_: OfxImageMemoryHandle, _: *mut *mut c_void) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn memory_unlock(_: OfxImageMemoryHandle) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+
+pub static SUITE: OfxImageEffectSuiteV1 = OfxImageEffectSuiteV1 {
+    getPropertySet: Some(get_property_set),
+    getParamSet: Some(get_param_set),
+    clipDefine: Some(clip_define),
+    clipGetHandle: Some(clip_get_handle),
+    clipGetPropertySet: Some(clip_get_property_set),
+    clipGetImage: Some(clip_get_image),
+    clipReleaseImage: Some(clip_release_image),
+    clipGetRegionOfDefinition: Some(clip_get_rod),
+    abort: Some(abort),
+    imageMemoryAlloc: Some(memory_alloc),
+    imageMemoryFree: Some(memory_free),
+    imageMemoryLock: Some(memory_lock),
+    imageMemoryUnlock: Some(memory_unlock),
+};
+
+/// # Safety
+/// Called by the C shim with the plugin's handle (checked against live effects) and C strings.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mfx_message_text(
+    handle: *mut c_void,
+    kind: *const c_char,
+    id: *const c_char,
+    text: *const c_char,
+) -> c_int {
+    let s = |p: *const c_char| {
+        if p.is_null() {
+            String::new()
+        } else {
+            // SAFETY: NUL-terminated strings from the plugin or the shim's buffer.
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+        }
+    };
+    let m = Message {
+        kind: s(kind),
+        id: s(id),
+        text: s(text),
+    };
+    match live_effect(handle) {
+        Some(e) => e.messages.lock().unwrap_or_else(|e| e.into_inner()).push(m),
+        None => eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text),
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" {
+    fn mfx_message(
+        handle: *mut c_void,
+        kind: *const c_char,
+        id: *const c_char,
+        format: *const c_char,
+        ...
+    ) -> OfxStatus;
+}
+
+pub static MESSAGE_SUITE: OfxMessageSuiteV1 = OfxMessageSuiteV1 {
+    message: Some(mfx_message),
+};

@@ -1,0 +1,638 @@
+//! The host side of OpenFX: loads a bundle through its C ABI and drives the
+//! action sequence a real host follows. All `unsafe` of the harness lives in
+//! this module, each block with its safety argument.
+
+pub mod effect;
+pub mod frame;
+pub mod params;
+pub mod props;
+
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use morphfx::geom::RectI;
+use openfx::sys::generic::core::*;
+use openfx::sys::generic::property::*;
+use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::message::*;
+use openfx::sys::image_effect_v1::param::*;
+
+pub use effect::{Effect, FrameSource, Message};
+pub use frame::Frame;
+use params::ParamValue;
+use props::PropertySet;
+
+/// Message id the plugin uses for the user's mistakes.
+pub const BAD_INPUT_ID: &str = "net.morphfx.BadInput";
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// Exit status 2: the input is at fault.
+    BadInput,
+    /// Exit status 1.
+    Failed,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct HostError {
+    pub kind: ErrorKind,
+    pub message: String,
+}
+
+impl HostError {
+    pub fn bad(m: impl Into<String>) -> Self {
+        HostError {
+            kind: ErrorKind::BadInput,
+            message: m.into(),
+        }
+    }
+    pub fn failed(m: impl Into<String>) -> Self {
+        HostError {
+            kind: ErrorKind::Failed,
+            message: m.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for HostError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+impl std::error::Error for HostError {}
+
+unsafe extern "C" fn fetch_suite(
+    _host: OfxPropertySetHandle,
+    name: *const c_char,
+    version: c_int,
+) -> *const c_void {
+    if name.is_null() {
+        return std::ptr::null();
+    }
+    // SAFETY: suite names are NUL-terminated C strings.
+    let name = unsafe { CStr::from_ptr(name) };
+    match (name, version) {
+        (n, 1) if n == kOfxPropertySuite => &props::SUITE as *const _ as *const c_void,
+        (n, 1) if n == kOfxImageEffectSuite => &effect::SUITE as *const _ as *const c_void,
+        (n, 1) if n == kOfxParameterSuite => &params::SUITE as *const _ as *const c_void,
+        (n, 1) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE as *const _ as *const c_void,
+        // Anything else (memory, multi-thread, interact, ...) this host does not
+        // provide: a null answer is how OFX says so.
+        _ => std::ptr::null(),
+    }
+}
+
+pub struct PluginInfo {
+    pub id: String,
+    pub version: (u32, u32),
+    plugin: *const OfxPlugin,
+}
+
+/// A loaded bundle and its plugins.
+pub struct Bundle {
+    pub binary: PathBuf,
+    pub plugins: Vec<PluginInfo>,
+    host: Box<OfxHost>,
+    _host_props: Box<PropertySet>,
+    _lib: libloading::Library,
+}
+
+/// The binary inside a bundle folder, or the path itself if it is a file.
+pub fn bundle_binary(path: &Path) -> PathBuf {
+    if path.is_dir() {
+        let stem = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("")
+            .trim_end_matches(".bundle");
+        path.join("Contents/Linux-x86-64").join(stem)
+    } else {
+        path.to_path_buf()
+    }
+}
+
+impl Bundle {
+    pub fn load(path: &Path) -> Result<Bundle, HostError> {
+        let binary = bundle_binary(path);
+        if !binary.is_file() {
+            return Err(HostError::bad(format!(
+                "plugin bundle {}: no binary at {}",
+                path.display(),
+                binary.display()
+            )));
+        }
+        // SAFETY: loading a shared library runs its initialisers; an OFX bundle
+        // is such a library by contract, and we load only the path we were given.
+        let lib = unsafe { libloading::Library::new(&binary) }
+            .map_err(|e| HostError::bad(format!("plugin bundle {}: {e}", binary.display())))?;
+        let host_props = Box::new(PropertySet::new());
+        host_props.set_str(kOfxPropName, "net.morphfx.harness");
+        host_props.set_str(kOfxPropLabel, "morphfx harness");
+        host_props.set_int(kOfxImageEffectHostPropIsBackground, &[1]);
+        host_props.set_int(kOfxImageEffectPropSupportsOverlays, &[0]);
+        host_props.set_int(kOfxImageEffectPropSupportsMultiResolution, &[1]);
+        host_props.set_int(kOfxImageEffectPropSupportsTiles, &[1]);
+        host_props.set_int(kOfxImageEffectPropTemporalClipAccess, &[1]);
+        host_props.set_strs(
+            kOfxImageEffectPropSupportedComponents,
+            &[
+                "OfxImageComponentRGBA",
+                "OfxImageComponentRGB",
+                "OfxImageComponentAlpha",
+            ],
+        );
+        host_props.set_strs(
+            kOfxImageEffectPropSupportedContexts,
+            &[
+                "OfxImageEffectContextGeneral",
+                "OfxImageEffectContextFilter",
+                "OfxImageEffectContextTransition",
+            ],
+        );
+        host_props.set_strs(
+            kOfxImageEffectPropSupportedPixelDepths,
+            &["OfxBitDepthByte", "OfxBitDepthShort", "OfxBitDepthFloat"],
+        );
+        host_props.set_int(kOfxImageEffectPropSupportsMultipleClipDepths, &[0]);
+        host_props.set_int(kOfxImageEffectPropSupportsMultipleClipPARs, &[0]);
+        host_props.set_int(kOfxParamHostPropSupportsStringAnimation, &[0]);
+        host_props.set_int(kOfxParamHostPropMaxParameters, &[-1]);
+        let host = Box::new(OfxHost {
+            host: host_props.handle(),
+            fetchSuite: Some(fetch_suite),
+        });
+
+        // SAFETY: the symbols have the OFX signatures; the library stays loaded
+        // (owned by the Bundle) for as long as anything it returned is used.
+        let plugins = unsafe {
+            if let Ok(set_host) =
+                lib.get::<unsafe extern "C" fn(*const OfxHost) -> OfxStatus>(b"OfxSetHost\0")
+            {
+                let st = set_host(&*host);
+                if st != kOfxStatOK {
+                    return Err(HostError::failed(format!(
+                        "OfxSetHost failed with status {st}"
+                    )));
+                }
+            }
+            let count = lib
+                .get::<unsafe extern "C" fn() -> c_int>(b"OfxGetNumberOfPlugins\0")
+                .map_err(|e| {
+                    HostError::bad(format!("{}: not an OFX bundle: {e}", binary.display()))
+                })?;
+            let get = lib
+                .get::<unsafe extern "C" fn(c_int) -> *mut OfxPlugin>(b"OfxGetPlugin\0")
+                .map_err(|e| {
+                    HostError::bad(format!("{}: not an OFX bundle: {e}", binary.display()))
+                })?;
+            let mut plugins = Vec::new();
+            for i in 0..count() {
+                let p = get(i);
+                let Some(plugin) = p.as_ref() else { continue };
+                if let Some(set_host) = plugin.setHost {
+                    set_host(&*host as *const OfxHost as *mut OfxHost);
+                }
+                plugins.push(PluginInfo {
+                    id: CStr::from_ptr(plugin.pluginIdentifier)
+                        .to_string_lossy()
+                        .into_owned(),
+                    version: (plugin.pluginVersionMajor, plugin.pluginVersionMinor),
+                    plugin: p,
+                });
+            }
+            plugins
+        };
+        Ok(Bundle {
+            binary,
+            plugins,
+            host,
+            _host_props: host_props,
+            _lib: lib,
+        })
+    }
+
+    fn call(
+        &self,
+        plugin: *const OfxPlugin,
+        action: &CStr,
+        handle: *const c_void,
+        in_args: Option<&PropertySet>,
+        out_args: Option<&PropertySet>,
+    ) -> OfxStatus {
+        let h = |p: Option<&PropertySet>| p.map_or(std::ptr::null_mut(), |p| p.handle());
+        // SAFETY: `plugin` came from this bundle's OfxGetPlugin and the library
+        // is loaded; handles are live objects of this host.
+        unsafe {
+            match (*plugin).mainEntry {
+                Some(main) => main(action.as_ptr(), handle, h(in_args), h(out_args)),
+                None => kOfxStatErrMissingHostFeature,
+            }
+        }
+    }
+
+    /// Loads, describes and instantiates plugin `id` in `context`.
+    pub fn instance(&self, id: &str, context: &str) -> Result<Instance<'_>, HostError> {
+        let info = self.plugins.iter().find(|p| p.id == id).ok_or_else(|| {
+            HostError::bad(format!(
+                "bundle {} has no plugin {id}",
+                self.binary.display()
+            ))
+        })?;
+        let plugin = info.plugin;
+        let check = |st: OfxStatus, what: &str, effect: Option<&Effect>| -> Result<(), HostError> {
+            if st == kOfxStatOK || st == kOfxStatReplyDefault {
+                Ok(())
+            } else {
+                Err(failure(st, what, effect))
+            }
+        };
+        check(
+            self.call(plugin, kOfxActionLoad, std::ptr::null(), None, None),
+            "load",
+            None,
+        )?;
+        let descriptor = Effect::new();
+        descriptor
+            .props
+            .set_str(kOfxPropType, "OfxTypeImageEffectHost");
+        check(
+            self.call(
+                plugin,
+                kOfxActionDescribe,
+                descriptor.handle() as *const c_void,
+                None,
+                None,
+            ),
+            "describe",
+            Some(&descriptor),
+        )?;
+        let contexts = descriptor.props.strs(kOfxImageEffectPropSupportedContexts);
+        if !contexts.iter().any(|c| c == context) {
+            return Err(HostError::bad(format!(
+                "plugin {id} does not support context {context} (it offers {})",
+                contexts.join(", ")
+            )));
+        }
+        let in_args = PropertySet::new();
+        in_args.set_str(kOfxImageEffectPropContext, context);
+        check(
+            self.call(
+                plugin,
+                kOfxImageEffectActionDescribeInContext,
+                descriptor.handle() as *const c_void,
+                Some(&in_args),
+                None,
+            ),
+            "describeInContext",
+            Some(&descriptor),
+        )?;
+
+        let effect = Effect::new();
+        for (k, v) in [
+            (kOfxPropType, "OfxTypeImageEffectInstance"),
+            (kOfxImageEffectPropContext, context),
+        ] {
+            effect.props.set_str(k, v);
+        }
+        effect
+            .props
+            .set_double(kOfxImageEffectPropFrameRate, &[24.0]);
+        effect
+            .props
+            .set_double(kOfxImageEffectPropProjectPixelAspectRatio, &[1.0]);
+        effect
+            .props
+            .set_ptr(kOfxPropInstanceData, std::ptr::null_mut());
+        let desc_params = params::ParamSet::instance_of(&descriptor.params);
+        *effect
+            .params
+            .params
+            .lock()
+            .unwrap_or_else(|e| e.into_inner()) =
+            std::mem::take(&mut *desc_params.params.lock().unwrap_or_else(|e| e.into_inner()));
+        for name in descriptor.clip_names() {
+            let desc_clip = descriptor.clip(&name).expect("listed");
+            let clip = effect.add_clip(&name, desc_clip.props.clone_values());
+            clip.props.set_int(kOfxImageClipPropConnected, &[0]);
+            clip.props
+                .set_str(kOfxImageClipPropFieldOrder, "OfxImageFieldNone");
+            clip.props.set_double(kOfxImagePropPixelAspectRatio, &[1.0]);
+            clip.props.set_double(kOfxImageEffectPropFrameRate, &[24.0]);
+        }
+        check(
+            self.call(
+                plugin,
+                kOfxActionCreateInstance,
+                effect.handle() as *const c_void,
+                None,
+                None,
+            ),
+            "createInstance",
+            Some(&effect),
+        )?;
+        Ok(Instance {
+            bundle: self,
+            plugin,
+            _descriptor: descriptor,
+            effect,
+        })
+    }
+
+    pub fn host(&self) -> &OfxHost {
+        &self.host
+    }
+}
+
+fn failure(status: OfxStatus, what: &str, effect: Option<&Effect>) -> HostError {
+    let messages = effect.map(|e| e.take_messages()).unwrap_or_default();
+    let errors: Vec<&Message> = messages
+        .iter()
+        .filter(|m| m.kind == kOfxMessageError.to_string_lossy())
+        .collect();
+    match errors.last() {
+        Some(m) if m.id == BAD_INPUT_ID || m.id.starts_with("net.morphfx.harness") => {
+            HostError::bad(m.text.clone())
+        }
+        Some(m) => HostError::failed(format!("{what}: {}", m.text)),
+        None => HostError::failed(format!("{what} failed with OFX status {status}")),
+    }
+}
+
+/// One plugin instance with its clips and params.
+pub struct Instance<'b> {
+    bundle: &'b Bundle,
+    plugin: *const OfxPlugin,
+    _descriptor: Box<Effect>,
+    pub effect: Box<Effect>,
+}
+
+/// How the output image is laid out (for testing host variety).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutputSpec {
+    pub depth: &'static str,
+    pub channels: usize,
+    pub top_down: bool,
+    pub render_scale: (f64, f64),
+    /// Split the window into this many bands rendered concurrently.
+    pub tiles: usize,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            depth: "OfxBitDepthFloat",
+            channels: 4,
+            top_down: false,
+            render_scale: (1.0, 1.0),
+            tiles: 1,
+        }
+    }
+}
+
+impl Instance<'_> {
+    fn param(&self, name: &str) -> Result<&params::Param, HostError> {
+        self.effect
+            .params
+            .get(name)
+            .ok_or_else(|| HostError::bad(format!("the plugin has no param {name}")))
+    }
+
+    pub fn param_names(&self) -> Vec<(String, String)> {
+        self.effect.params.names()
+    }
+
+    pub fn param_props(&self, name: &str) -> Option<&PropertySet> {
+        self.effect.params.get(name).map(|p| &p.props)
+    }
+
+    pub fn set_double(
+        &self,
+        name: &str,
+        values: &[f64],
+        time: Option<f64>,
+    ) -> Result<(), HostError> {
+        let p = self.param(name)?;
+        let mut v = ParamValue::default();
+        v.d[..values.len()].copy_from_slice(values);
+        match time {
+            Some(t) => p.set_key(t, v),
+            None => p.set(v),
+        }
+        Ok(())
+    }
+
+    pub fn set_int(&self, name: &str, value: i32) -> Result<(), HostError> {
+        let p = self.param(name)?;
+        let mut v = ParamValue::default();
+        v.i[0] = value;
+        p.set(v);
+        Ok(())
+    }
+
+    pub fn set_string(&self, name: &str, value: &str) -> Result<(), HostError> {
+        let p = self.param(name)?;
+        p.set(ParamValue {
+            s: CString::new(value).map_err(|_| HostError::bad(format!("{name}: NUL in text")))?,
+            ..Default::default()
+        });
+        Ok(())
+    }
+
+    /// Sets `name`'s option by its label (choice params).
+    pub fn set_choice(&self, name: &str, option: &str) -> Result<(), HostError> {
+        let p = self.param(name)?;
+        let options = p.props.strs(kOfxParamPropChoiceOption);
+        let i = options
+            .iter()
+            .position(|o| o == option || o.split(' ').next() == Some(option))
+            .ok_or_else(|| {
+                HostError::bad(format!(
+                    "{name}: unknown option \"{option}\" (one of {})",
+                    options.join(", ")
+                ))
+            })?;
+        self.set_int(name, i as i32)
+    }
+
+    pub fn connect(&self, clip: &str, source: Arc<dyn FrameSource>) -> Result<(), HostError> {
+        let c = self
+            .effect
+            .clip(clip)
+            .ok_or_else(|| HostError::bad(format!("the plugin has no clip {clip}")))?;
+        *c.source.lock().unwrap_or_else(|e| e.into_inner()) = Some(source);
+        c.props.set_int(kOfxImageClipPropConnected, &[1]);
+        Ok(())
+    }
+
+    pub fn set_project(&self, width: f64, height: f64) {
+        for k in [
+            kOfxImageEffectPropProjectSize,
+            kOfxImageEffectPropProjectExtent,
+        ] {
+            self.effect.props.set_double(k, &[width, height]);
+        }
+        self.effect
+            .props
+            .set_double(kOfxImageEffectPropProjectOffset, &[0.0, 0.0]);
+    }
+
+    fn act(
+        &self,
+        action: &CStr,
+        in_args: Option<&PropertySet>,
+        out_args: Option<&PropertySet>,
+    ) -> Result<OfxStatus, HostError> {
+        let st = self.bundle.call(
+            self.plugin,
+            action,
+            self.effect.handle() as *const c_void,
+            in_args,
+            out_args,
+        );
+        if st == kOfxStatOK || st == kOfxStatReplyDefault {
+            Ok(st)
+        } else {
+            Err(failure(st, &action.to_string_lossy(), Some(&self.effect)))
+        }
+    }
+
+    pub fn begin_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
+        let a = PropertySet::new();
+        a.set_double(kOfxImageEffectPropFrameRange, &[first, last]);
+        a.set_double(kOfxImageEffectPropFrameStep, &[1.0]);
+        a.set_int(kOfxPropIsInteractive, &[0]);
+        a.set_double(kOfxImageEffectPropRenderScale, &[1.0, 1.0]);
+        self.act(kOfxImageEffectActionBeginSequenceRender, Some(&a), None)
+            .map(|_| ())
+    }
+
+    pub fn end_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
+        let a = PropertySet::new();
+        a.set_double(kOfxImageEffectPropFrameRange, &[first, last]);
+        a.set_double(kOfxImageEffectPropFrameStep, &[1.0]);
+        a.set_int(kOfxPropIsInteractive, &[0]);
+        a.set_double(kOfxImageEffectPropRenderScale, &[1.0, 1.0]);
+        self.act(kOfxImageEffectActionEndSequenceRender, Some(&a), None)
+            .map(|_| ())
+    }
+
+    /// The output's region of definition at `time` (canonical).
+    pub fn region_of_definition(&self, time: f64, scale: (f64, f64)) -> Result<RectI, HostError> {
+        let a = PropertySet::new();
+        a.set_double(kOfxPropTime, &[time]);
+        a.set_double(kOfxImageEffectPropRenderScale, &[scale.0, scale.1]);
+        let out = PropertySet::new();
+        self.act(
+            kOfxImageEffectActionGetRegionOfDefinition,
+            Some(&a),
+            Some(&out),
+        )?;
+        let r = out.doubles(kOfxImageEffectPropRegionOfDefinition);
+        if r.len() != 4 {
+            return Err(HostError::failed("the plugin gave no region of definition"));
+        }
+        Ok(RectI::new(
+            r[0].floor() as i32,
+            r[1].floor() as i32,
+            r[2].ceil() as i32,
+            r[3].ceil() as i32,
+        ))
+    }
+
+    /// Renders the frame at `time` into a new buffer laid out as `spec`.
+    pub fn render(&self, time: f64, spec: OutputSpec) -> Result<Arc<Frame>, HostError> {
+        self.effect.take_messages();
+        *self
+            .effect
+            .render_scale
+            .lock()
+            .unwrap_or_else(|e| e.into_inner()) = spec.render_scale;
+        let rod = self.region_of_definition(time, spec.render_scale)?;
+        let (sx, sy) = spec.render_scale;
+        let bounds = RectI::new(
+            (rod.x1 as f64 * sx).floor() as i32,
+            (rod.y1 as f64 * sy).floor() as i32,
+            (rod.x2 as f64 * sx).ceil() as i32,
+            (rod.y2 as f64 * sy).ceil() as i32,
+        );
+        let out = Arc::new(Frame::blank(
+            bounds,
+            spec.channels,
+            spec.depth,
+            spec.top_down,
+        ));
+        let out_clip = self
+            .effect
+            .clip("Output")
+            .ok_or_else(|| HostError::failed("the plugin has no Output clip"))?;
+        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = Some(out.clone());
+        out_clip
+            .props
+            .set_str(kOfxImageEffectPropPixelDepth, spec.depth);
+        let tiles = spec.tiles.max(1) as i32;
+        let band = (bounds.height() as i32 + tiles - 1) / tiles;
+        let windows: Vec<RectI> = (0..tiles)
+            .map(|k| {
+                RectI::new(
+                    bounds.x1,
+                    bounds.y1 + k * band,
+                    bounds.x2,
+                    (bounds.y1 + (k + 1) * band).min(bounds.y2),
+                )
+            })
+            .filter(|w| !w.is_empty())
+            .collect();
+        let render_one = |w: RectI| {
+            let a = PropertySet::new();
+            a.set_double(kOfxPropTime, &[time]);
+            a.set_str(kOfxImageEffectPropFieldToRender, "OfxImageFieldNone");
+            a.set_int(kOfxImageEffectPropRenderWindow, &[w.x1, w.y1, w.x2, w.y2]);
+            a.set_double(kOfxImageEffectPropRenderScale, &[sx, sy]);
+            a.set_int(kOfxImageEffectPropSequentialRenderStatus, &[0]);
+            a.set_int(kOfxImageEffectPropInteractiveRenderStatus, &[0]);
+            self.act(kOfxImageEffectActionRender, Some(&a), None)
+        };
+        let result: Result<Vec<_>, HostError> = if windows.len() == 1 {
+            windows.iter().map(|w| render_one(*w)).collect()
+        } else {
+            std::thread::scope(|s| {
+                let handles: Vec<_> = windows
+                    .iter()
+                    .map(|w| s.spawn(move || render_one(*w)))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| {
+                        h.join()
+                            .unwrap_or_else(|_| Err(HostError::failed("render thread panicked")))
+                    })
+                    .collect()
+            })
+        };
+        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        result?;
+        Ok(out)
+    }
+}
+
+impl Drop for Instance<'_> {
+    fn drop(&mut self) {
+        let _ = self.bundle.call(
+            self.plugin,
+            kOfxActionDestroyInstance,
+            self.effect.handle() as *const c_void,
+            None,
+            None,
+        );
+    }
+}
+
+// SAFETY: plugin pointers are immutable statics of the loaded library; the
+// host struct and its property set are only read after loading. OFX renders
+// may be called from any thread for a plugin that declares itself thread safe.
+unsafe impl Send for PluginInfo {}
+unsafe impl Sync for PluginInfo {}
+unsafe impl Send for Bundle {}
+unsafe impl Sync for Bundle {}
+unsafe impl Sync for Instance<'_> {}

@@ -1,0 +1,453 @@
+//! Params with real per-param storage and keyframes (linear for doubles,
+//! stepped for the rest), and the parameter suite.
+
+use std::ffi::{c_char, c_int, c_uint, CStr, CString};
+use std::sync::Mutex;
+
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::param::*;
+
+use super::props::PropertySet;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    Double(usize),
+    Int(usize),
+    Str,
+    /// Groups, pages, buttons: no value.
+    None,
+}
+
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ParamValue {
+    pub d: [f64; 4],
+    pub i: [i32; 4],
+    pub s: CString,
+}
+
+pub struct Param {
+    pub name: String,
+    pub kind: String,
+    pub props: PropertySet,
+    state: Mutex<(ParamValue, Vec<(f64, ParamValue)>)>,
+}
+
+impl Param {
+    pub fn shape(&self) -> Shape {
+        match self.kind.as_str() {
+            "OfxParamTypeDouble" => Shape::Double(1),
+            "OfxParamTypeDouble2D" => Shape::Double(2),
+            "OfxParamTypeDouble3D" => Shape::Double(3),
+            "OfxParamTypeRGB" => Shape::Double(3),
+            "OfxParamTypeRGBA" => Shape::Double(4),
+            "OfxParamTypeInteger" | "OfxParamTypeBoolean" | "OfxParamTypeChoice" => Shape::Int(1),
+            "OfxParamTypeInteger2D" => Shape::Int(2),
+            "OfxParamTypeInteger3D" => Shape::Int(3),
+            "OfxParamTypeString" | "OfxParamTypeStrChoice" => Shape::Str,
+            _ => Shape::None,
+        }
+    }
+
+    /// A param of an instance, valued at its descriptor's default.
+    pub fn instance_of(desc: &Param) -> Param {
+        let props = desc.props.clone_values();
+        let mut v = ParamValue::default();
+        match desc.shape() {
+            Shape::Double(n) => {
+                for (k, d) in props
+                    .doubles(kOfxParamPropDefault)
+                    .into_iter()
+                    .take(n)
+                    .enumerate()
+                {
+                    v.d[k] = d;
+                }
+            }
+            Shape::Int(n) => {
+                for (k, i) in props
+                    .ints(kOfxParamPropDefault)
+                    .into_iter()
+                    .take(n)
+                    .enumerate()
+                {
+                    v.i[k] = i;
+                }
+            }
+            Shape::Str => {
+                v.s = CString::new(props.str(kOfxParamPropDefault).unwrap_or_default())
+                    .unwrap_or_default()
+            }
+            Shape::None => {}
+        }
+        Param {
+            name: desc.name.clone(),
+            kind: desc.kind.clone(),
+            props,
+            state: Mutex::new((v, Vec::new())),
+        }
+    }
+
+    fn state(&self) -> std::sync::MutexGuard<'_, (ParamValue, Vec<(f64, ParamValue)>)> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub fn value_at(&self, time: f64) -> ParamValue {
+        let st = self.state();
+        let (value, keys) = &*st;
+        if keys.is_empty() {
+            return value.clone();
+        }
+        if time <= keys[0].0 {
+            return keys[0].1.clone();
+        }
+        let last = keys.len() - 1;
+        if time >= keys[last].0 {
+            return keys[last].1.clone();
+        }
+        let hi = keys.iter().position(|k| k.0 > time).unwrap_or(last);
+        let (t0, v0) = &keys[hi - 1];
+        let (t1, v1) = &keys[hi];
+        let w = (time - t0) / (t1 - t0);
+        let mut out = v0.clone();
+        if let Shape::Double(n) = self.shape() {
+            for k in 0..n {
+                out.d[k] = v0.d[k] + (v1.d[k] - v0.d[k]) * w;
+            }
+        }
+        out
+    }
+
+    pub fn set(&self, v: ParamValue) {
+        let mut st = self.state();
+        st.0 = v;
+        st.1.clear();
+    }
+
+    /// Keys `v` at `time` (replacing a key already there).
+    pub fn set_key(&self, time: f64, v: ParamValue) {
+        let mut st = self.state();
+        let keys = &mut st.1;
+        keys.retain(|k| k.0 != time);
+        keys.push((time, v));
+        keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+
+    pub fn num_keys(&self) -> usize {
+        self.state().1.len()
+    }
+}
+
+#[derive(Default)]
+pub struct ParamSet {
+    pub props: PropertySet,
+    pub params: Mutex<Vec<Box<Param>>>,
+}
+
+impl ParamSet {
+    pub fn find(&self, name: &str) -> Option<*const Param> {
+        let params = self.params.lock().unwrap_or_else(|e| e.into_inner());
+        params
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| &**p as *const Param)
+    }
+    /// The instance's copy of a descriptor's params.
+    pub fn instance_of(desc: &ParamSet) -> ParamSet {
+        let params = desc.params.lock().unwrap_or_else(|e| e.into_inner());
+        ParamSet {
+            props: desc.props.clone_values(),
+            params: Mutex::new(
+                params
+                    .iter()
+                    .map(|p| Box::new(Param::instance_of(p)))
+                    .collect(),
+            ),
+        }
+    }
+    pub fn names(&self) -> Vec<(String, String)> {
+        let params = self.params.lock().unwrap_or_else(|e| e.into_inner());
+        params
+            .iter()
+            .map(|p| (p.name.clone(), p.kind.clone()))
+            .collect()
+    }
+    /// The param called `name`; lives as long as this set.
+    pub fn get(&self, name: &str) -> Option<&Param> {
+        // SAFETY: params are boxed and never removed, so the pointer lives as long as `self`.
+        self.find(name).map(|p| unsafe { &*p })
+    }
+}
+
+/// # Safety
+/// `h` must be null or a param handle this host made.
+unsafe fn param_of<'a>(h: OfxParamHandle) -> Option<&'a Param> {
+    // SAFETY: param handles point at boxed Params owned by a live ParamSet.
+    unsafe { (h as *const Param).as_ref() }
+}
+
+unsafe extern "C" fn param_define(
+    set: OfxParamSetHandle,
+    kind: *const c_char,
+    name: *const c_char,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    // SAFETY: set handles point at live ParamSets; strings are NUL-terminated.
+    let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if kind.is_null() || name.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    let (kind, name) = unsafe { (CStr::from_ptr(kind), CStr::from_ptr(name)) };
+    let name = name.to_string_lossy().into_owned();
+    let mut params = set.params.lock().unwrap_or_else(|e| e.into_inner());
+    if params.iter().any(|p| p.name == name) {
+        return kOfxStatErrExists;
+    }
+    let p = Box::new(Param {
+        name: name.clone(),
+        kind: kind.to_string_lossy().into_owned(),
+        props: PropertySet::new(),
+        state: Mutex::new(Default::default()),
+    });
+    p.props.set_str(kOfxParamPropType, &p.kind);
+    p.props.set_str(kOfxPropName, &name);
+    if !props.is_null() {
+        // SAFETY: non-null out-pointer from the plugin.
+        unsafe { *props = p.props.handle() };
+    }
+    params.push(p);
+    kOfxStatOK
+}
+
+unsafe extern "C" fn param_get_handle(
+    set: OfxParamSetHandle,
+    name: *const c_char,
+    param: *mut OfxParamHandle,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    // SAFETY: set handles point at live ParamSets; name NUL-terminated.
+    let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if name.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
+    let Some(p) = set.find(&name) else {
+        return kOfxStatErrUnknown;
+    };
+    // SAFETY: out-pointers are the plugin's; `p` is a live boxed Param.
+    unsafe {
+        if !param.is_null() {
+            *param = p as OfxParamHandle;
+        }
+        if !props.is_null() {
+            *props = (*p).props.handle();
+        }
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn param_set_props(
+    set: OfxParamSetHandle,
+    props: *mut OfxPropertySetHandle,
+) -> OfxStatus {
+    // SAFETY: set handles point at live ParamSets.
+    let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if !props.is_null() {
+        unsafe { *props = set.props.handle() };
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn param_props(h: OfxParamHandle, props: *mut OfxPropertySetHandle) -> OfxStatus {
+    // SAFETY: see `param_of`.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if !props.is_null() {
+        unsafe { *props = p.props.handle() };
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn num_keys(h: OfxParamHandle, n: *mut c_uint) -> OfxStatus {
+    // SAFETY: see `param_of`.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    if !n.is_null() {
+        unsafe { *n = p.num_keys() as c_uint };
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" fn unsupported_key_time(
+    _: OfxParamHandle,
+    _: c_uint,
+    _: *mut OfxTime,
+) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn unsupported_key_index(
+    _: OfxParamHandle,
+    _: OfxTime,
+    _: c_int,
+    _: *mut c_int,
+) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn unsupported_delete_key(_: OfxParamHandle, _: OfxTime) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn delete_all_keys(h: OfxParamHandle) -> OfxStatus {
+    // SAFETY: see `param_of`.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    let v = p.value_at(0.0);
+    p.set(v);
+    kOfxStatOK
+}
+unsafe extern "C" fn unsupported_copy(
+    _: OfxParamHandle,
+    _: OfxParamHandle,
+    _: OfxTime,
+    _: *const OfxRangeD,
+) -> OfxStatus {
+    kOfxStatErrUnsupported
+}
+unsafe extern "C" fn edit(_: OfxParamSetHandle) -> OfxStatus {
+    kOfxStatOK
+}
+unsafe extern "C" fn edit_begin(_: OfxParamSetHandle, _: *const c_char) -> OfxStatus {
+    kOfxStatOK
+}
+
+// The C shim (varargs.c) unpacks variadic arguments through these.
+
+/// # Safety
+/// Called by the C shim with a param handle from the plugin and live out-pointers.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mfx_param_shape(
+    h: OfxParamHandle,
+    kind: *mut c_int,
+    dim: *mut c_int,
+) -> c_int {
+    // SAFETY: see `param_of`; out-pointers are the shim's locals.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    let (k, d) = match p.shape() {
+        Shape::Double(n) => (0, n),
+        Shape::Int(n) => (1, n),
+        Shape::Str => (2, 1),
+        Shape::None => return kOfxStatErrValue,
+    };
+    unsafe {
+        *kind = k;
+        *dim = d as c_int;
+    }
+    kOfxStatOK
+}
+
+/// # Safety
+/// As `mfx_param_shape`; `d` and `iv` have room for 4 values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mfx_param_get(
+    h: OfxParamHandle,
+    time: f64,
+    at_time: c_int,
+    d: *mut f64,
+    iv: *mut c_int,
+    s: *mut *const c_char,
+) -> c_int {
+    // SAFETY: see `param_of`.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    let v = p.value_at(if at_time != 0 { time } else { 0.0 });
+    // SAFETY: the shim's arrays hold 4 values; the string pointer stays valid
+    // because the param keeps an equal CString until it is set again — we
+    // return the stored one, not the copy.
+    unsafe {
+        for k in 0..4 {
+            *d.add(k) = v.d[k];
+            *iv.add(k) = v.i[k];
+        }
+        let st = p.state();
+        let stored =
+            st.1.iter()
+                .find(|(_, kv)| kv.s == v.s)
+                .map(|(_, kv)| &kv.s)
+                .unwrap_or(&st.0.s);
+        *s = stored.as_ptr();
+    }
+    kOfxStatOK
+}
+
+/// # Safety
+/// As `mfx_param_get`; `s` is null or NUL-terminated.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mfx_param_set(
+    h: OfxParamHandle,
+    time: f64,
+    at_time: c_int,
+    d: *const f64,
+    iv: *const c_int,
+    s: *const c_char,
+) -> c_int {
+    // SAFETY: see `param_of`; arrays hold 4 values.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    let mut v = ParamValue::default();
+    unsafe {
+        for k in 0..4 {
+            v.d[k] = *d.add(k);
+            v.i[k] = *iv.add(k);
+        }
+        if !s.is_null() {
+            v.s = CStr::from_ptr(s).to_owned();
+        }
+    }
+    if at_time != 0 {
+        p.set_key(time, v);
+    } else {
+        p.set(v);
+    }
+    kOfxStatOK
+}
+
+unsafe extern "C" {
+    fn mfx_paramGetValue(h: OfxParamHandle, ...) -> OfxStatus;
+    fn mfx_paramGetValueAtTime(h: OfxParamHandle, time: OfxTime, ...) -> OfxStatus;
+    fn mfx_paramSetValue(h: OfxParamHandle, ...) -> OfxStatus;
+    fn mfx_paramSetValueAtTime(h: OfxParamHandle, time: OfxTime, ...) -> OfxStatus;
+    fn mfx_paramGetDerivative(h: OfxParamHandle, time: OfxTime, ...) -> OfxStatus;
+    fn mfx_paramGetIntegral(h: OfxParamHandle, t1: OfxTime, t2: OfxTime, ...) -> OfxStatus;
+}
+
+pub static SUITE: OfxParameterSuiteV1 = OfxParameterSuiteV1 {
+    paramDefine: Some(param_define),
+    paramGetHandle: Some(param_get_handle),
+    paramSetGetPropertySet: Some(param_set_props),
+    paramGetPropertySet: Some(param_props),
+    paramGetValue: Some(mfx_paramGetValue),
+    paramGetValueAtTime: Some(mfx_paramGetValueAtTime),
+    paramGetDerivative: Some(mfx_paramGetDerivative),
+    paramGetIntegral: Some(mfx_paramGetIntegral),
+    paramSetValue: Some(mfx_paramSetValue),
+    paramSetValueAtTime: Some(mfx_paramSetValueAtTime),
+    paramGetNumKeys: Some(num_keys),
+    paramGetKeyTime: Some(unsupported_key_time),
+    paramGetKeyIndex: Some(unsupported_key_index),
+    paramDeleteKey: Some(unsupported_delete_key),
+    paramDeleteAllKeys: Some(delete_all_keys),
+    paramCopy: Some(unsupported_copy),
+    paramEditBegin: Some(edit_begin),
+    paramEditEnd: Some(edit),
+};

@@ -1,0 +1,248 @@
+//! Frame IO. EXR is read and written at full precision (half or float); PNG,
+//! JPEG and TIFF are read (their code values kept as they are, not linearised).
+//! Outputs go to a temporary name and are renamed when complete.
+
+use std::path::Path;
+
+use exr::prelude::*;
+use morphfx::geom::RectI;
+use morphfx::image::Image;
+
+use crate::host::HostError;
+
+/// A plate: pixels in canonical coordinates (bottom-up) plus the frame it sits in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plate {
+    pub image: Image,
+    /// Width and height of the display window (the canonical frame).
+    pub size: (usize, usize),
+}
+
+pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
+    if !path.exists() {
+        return Err(HostError::bad(format!("{}: no such file", path.display())));
+    }
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext == "exr" {
+        read_exr(path)
+    } else {
+        read_other(path)
+    }
+}
+
+fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
+    let img = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| HostError::bad(format!("{}: cannot read EXR: {e}", path.display())))?;
+    let display = img.attributes.display_window;
+    let layer = &img.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let pos = layer.attributes.layer_position;
+    let find = |names: &[&str]| {
+        layer.channel_data.list.iter().position(|c| {
+            names.iter().any(|n| {
+                c.name.eq_case_insensitive(n) || c.name.to_string().ends_with(&format!(".{n}"))
+            })
+        })
+    };
+    let (r, g, b, a, y) = (
+        find(&["R", "red"]),
+        find(&["G", "green"]),
+        find(&["B", "blue"]),
+        find(&["A", "alpha"]),
+        find(&["Y"]),
+    );
+    // Map channels: RGB(A) as they are; Y as grey; otherwise the first channels in order.
+    let list = &layer.channel_data.list;
+    let picks: Vec<Option<usize>> = match (r, g, b, y) {
+        (Some(r), Some(g), Some(b), _) => vec![Some(r), Some(g), Some(b), a],
+        (_, _, _, Some(y)) => vec![Some(y), Some(y), Some(y), a],
+        _ if list.len() == 1 => vec![Some(0), Some(0), Some(0), None],
+        _ => (0..4).map(|k| (k < list.len()).then_some(k)).collect(),
+    };
+    let (dx, dy_top) = (display.position.x(), display.position.y());
+    let dh = display.size.height() as i32;
+    // EXR y grows downwards; canonical y grows upwards from the display window's bottom.
+    let bounds = RectI::new(
+        pos.x() - dx,
+        dy_top + dh - (pos.y() + h as i32),
+        pos.x() - dx + w as i32,
+        dy_top + dh - pos.y(),
+    );
+    let mut image = Image::new(bounds, 4);
+    for (c, pick) in picks.iter().enumerate() {
+        match pick {
+            Some(k) => {
+                let samples = &list[*k].sample_data;
+                for row in 0..h {
+                    let j = h - 1 - row;
+                    for x in 0..w {
+                        image.data[(j * w + x) * 4 + c] =
+                            samples.value_by_flat_index(row * w + x).to_f32();
+                    }
+                }
+            }
+            None => {
+                for px in image.data.chunks_exact_mut(4) {
+                    px[c] = 1.0;
+                }
+            }
+        }
+    }
+    Ok(Plate {
+        image,
+        size: (display.size.width(), display.size.height()),
+    })
+}
+
+fn read_other(path: &Path) -> std::result::Result<Plate, HostError> {
+    let img = ::image::open(path)
+        .map_err(|e| HostError::bad(format!("{}: cannot read image: {e}", path.display())))?;
+    let rgba = img.to_rgba32f();
+    let (w, h) = (rgba.width() as usize, rgba.height() as usize);
+    let mut image = Image::new(RectI::from_size(w, h), 4);
+    for (x, yr, p) in rgba.enumerate_pixels() {
+        let j = h - 1 - yr as usize;
+        let k = (j * w + x as usize) * 4;
+        image.data[k..k + 4].copy_from_slice(&p.0);
+    }
+    Ok(Plate {
+        image,
+        size: (w, h),
+    })
+}
+
+/// Output sample type of EXR files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExrPrecision {
+    #[default]
+    Float,
+    Half,
+}
+
+/// Writes `plate` (RGBA, or fewer channels) to `path` atomically: a temporary
+/// file in the same folder, renamed over the final name only when complete.
+pub fn write(
+    path: &Path,
+    plate: &Plate,
+    precision: ExrPrecision,
+) -> std::result::Result<(), HostError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)
+        .map_err(|e| HostError::bad(format!("{}: cannot create folder: {e}", dir.display())))?;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let result = match ext.as_str() {
+        "exr" => write_exr(&tmp, plate, precision),
+        "png" | "tif" | "tiff" | "jpg" | "jpeg" => write_other(&tmp, plate, &ext),
+        _ => Err(HostError::bad(format!(
+            "{}: unknown output format (use .exr or .png)",
+            path.display()
+        ))),
+    };
+    match result.and_then(|_| {
+        std::fs::rename(&tmp, path)
+            .map_err(|e| HostError::failed(format!("{}: {e}", path.display())))
+    }) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+fn rgba_at(plate: &Plate, x: usize, row_from_top: usize) -> [f32; 4] {
+    let img = &plate.image;
+    let (w, h) = (img.width(), img.height());
+    let j = h - 1 - row_from_top;
+    let k = (j * w + x) * img.channels;
+    match img.channels {
+        1 => [img.data[k]; 4],
+        3 => [img.data[k], img.data[k + 1], img.data[k + 2], 1.0],
+        _ => [
+            img.data[k],
+            img.data[k + 1],
+            img.data[k + 2],
+            img.data[k + 3],
+        ],
+    }
+}
+
+fn write_exr(
+    path: &Path,
+    plate: &Plate,
+    precision: ExrPrecision,
+) -> std::result::Result<(), HostError> {
+    let img = &plate.image;
+    let (w, h) = (img.width(), img.height());
+    let b = img.bounds;
+    let dh = plate.size.1 as i32;
+    let pixel = |pos: Vec2<usize>| rgba_at(plate, pos.x(), pos.y());
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        ..Encoding::default()
+    };
+    let err = |e: exr::error::Error| {
+        HostError::failed(format!("{}: cannot write EXR: {e}", path.display()))
+    };
+    let position = Vec2(b.x1, dh - b.y2);
+    let display = IntegerBounds::new(Vec2(0, 0), Vec2(plate.size.0, plate.size.1));
+    macro_rules! write_with {
+        ($conv:expr) => {{
+            let channels = SpecificChannels::rgba(move |pos: Vec2<usize>| {
+                let p = pixel(pos);
+                ($conv(p[0]), $conv(p[1]), $conv(p[2]), $conv(p[3]))
+            });
+            let mut layer = Layer::new(Vec2(w, h), LayerAttributes::default(), encoding, channels);
+            layer.attributes.layer_position = position;
+            let mut image = exr::prelude::Image::from_layer(layer);
+            image.attributes.display_window = display;
+            image.write().to_file(path).map_err(err)
+        }};
+    }
+    match precision {
+        ExrPrecision::Float => write_with!(|v: f32| v),
+        ExrPrecision::Half => write_with!(f16::from_f32),
+    }
+}
+
+fn write_other(path: &Path, plate: &Plate, ext: &str) -> std::result::Result<(), HostError> {
+    let img = &plate.image;
+    let (w, h) = (img.width(), img.height());
+    let mut out = ::image::RgbaImage::new(w as u32, h as u32);
+    for (x, y, p) in out.enumerate_pixels_mut() {
+        let v = rgba_at(plate, x as usize, y as usize);
+        p.0 = v.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+    }
+    let format = match ext {
+        "png" => ::image::ImageFormat::Png,
+        "jpg" | "jpeg" => ::image::ImageFormat::Jpeg,
+        _ => ::image::ImageFormat::Tiff,
+    };
+    let result = if format == ::image::ImageFormat::Jpeg {
+        ::image::DynamicImage::ImageRgba8(out)
+            .to_rgb8()
+            .save_with_format(path, format)
+    } else {
+        out.save_with_format(path, format)
+    };
+    result.map_err(|e| HostError::failed(format!("{}: cannot write: {e}", path.display())))
+}

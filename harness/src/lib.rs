@@ -1,0 +1,6 @@
+//! `morphfx`, the standalone harness: an OpenFX host for the MorphFX bundle
+//! (reached only through its C ABI), EXR/PNG/JPEG/TIFF frame IO, sequences.
+
+pub mod host;
+pub mod io;
+pub mod sequence;

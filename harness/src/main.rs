@@ -1,0 +1,522 @@
+//! `morphfx`: render the MorphFX bundle on plates (CONTRACT §3).
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use clap::{Parser, Subcommand};
+use morphfx::geom::RectI;
+use morphfx::image::Image;
+use morphfx::scene::Scene;
+use morphfx_harness::host::{Bundle, ErrorKind, Frame, FrameSource, HostError, OutputSpec};
+use morphfx_harness::io::{self, ExrPrecision, Plate};
+use morphfx_harness::sequence::{frame_path, is_sequence, parse_frames};
+
+const MORPH_ID: &str = "net.morphfx.Morph";
+const WARP_ID: &str = "net.morphfx.Warp";
+
+#[derive(Parser)]
+#[command(
+    name = "morphfx",
+    version,
+    about = "Render MorphFX morphs through the OpenFX plugin bundle"
+)]
+struct Cli {
+    /// The plugin bundle (MorphFX.ofx.bundle or its binary). Default: OFX_PLUGIN_PATH,
+    /// then the bundle built in this checkout, then /usr/OFX/Plugins.
+    #[arg(long, global = true)]
+    bundle: Option<PathBuf>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Args, Clone)]
+struct Common {
+    /// Scene file (*.morph.json).
+    #[arg(long)]
+    scene: PathBuf,
+    /// Progress t in [0, 1]; overrides the scene's progress keys.
+    #[arg(long)]
+    t: Option<f64>,
+    /// Frames to render, e.g. 1001-1048.
+    #[arg(long)]
+    frames: Option<String>,
+    /// Output file or #-padded sequence.
+    #[arg(short = 'o', long = "output")]
+    output: String,
+    /// Write half-float EXR instead of float.
+    #[arg(long)]
+    half: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render the in-between image(s) of A and B.
+    Morph {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long)]
+        a: String,
+        #[arg(long)]
+        b: String,
+        #[arg(long = "stmap-a")]
+        stmap_a: Option<String>,
+        #[arg(long = "stmap-b")]
+        stmap_b: Option<String>,
+        /// morph, warped-a, warped-b, stmap-a, stmap-b, transition, grid
+        #[arg(long, default_value = "morph")]
+        view: String,
+        /// general or transition
+        #[arg(long, default_value = "general")]
+        context: String,
+    },
+    /// Render A warped toward the features' positions at t.
+    Warp {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long)]
+        input: String,
+        #[arg(long)]
+        stmap: Option<String>,
+        /// warped, stmap, grid
+        #[arg(long, default_value = "warped")]
+        view: String,
+    },
+    /// Render a morph of built-in generated plates.
+    Demo {
+        #[arg(short = 'o', long = "output", default_value = "morphfx-demo")]
+        output: PathBuf,
+    },
+    /// List the plugins in the bundle.
+    Plugins,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => {}
+        Err(e) => {
+            eprintln!("morphfx: error: {}", e.message);
+            std::process::exit(if e.kind == ErrorKind::BadInput { 2 } else { 1 });
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), HostError> {
+    let bundle_path = find_bundle(cli.bundle.as_deref())?;
+    match cli.command {
+        Command::Plugins => {
+            let bundle = Bundle::load(&bundle_path)?;
+            println!("bundle: {}", bundle.binary.display());
+            for p in &bundle.plugins {
+                println!("{}\t{}.{}", p.id, p.version.0, p.version.1);
+            }
+            Ok(())
+        }
+        Command::Morph {
+            common,
+            a,
+            b,
+            stmap_a,
+            stmap_b,
+            view,
+            context,
+        } => {
+            let ctx = match context.as_str() {
+                "general" => "OfxImageEffectContextGeneral",
+                "transition" => "OfxImageEffectContextTransition",
+                other => {
+                    return Err(HostError::bad(format!(
+                        "--context {other}: expected general or transition"
+                    )))
+                }
+            };
+            let (ca, cb) = if context == "transition" {
+                ("SourceFrom", "SourceTo")
+            } else {
+                ("SourceA", "SourceB")
+            };
+            let job = Job {
+                plugin: MORPH_ID,
+                context: ctx,
+                sources: vec![(ca.to_owned(), a), (cb.to_owned(), b)],
+                view,
+                extra: [("stmap-a", stmap_a), ("stmap-b", stmap_b)]
+                    .into_iter()
+                    .filter_map(|(v, o)| o.map(|o| (v.to_owned(), o)))
+                    .collect(),
+                common,
+            };
+            job.run(&bundle_path)
+        }
+        Command::Warp {
+            common,
+            input,
+            stmap,
+            view,
+        } => {
+            let job = Job {
+                plugin: WARP_ID,
+                context: "OfxImageEffectContextFilter",
+                sources: vec![("Source".to_owned(), input)],
+                view,
+                extra: stmap
+                    .map(|s| vec![("stmap".to_owned(), s)])
+                    .unwrap_or_default(),
+                common,
+            };
+            job.run(&bundle_path)
+        }
+        Command::Demo { output } => demo(&bundle_path, &output),
+    }
+}
+
+fn find_bundle(given: Option<&Path>) -> Result<PathBuf, HostError> {
+    const NAME: &str = "MorphFX.ofx.bundle";
+    if let Some(p) = given {
+        return Ok(p.to_path_buf());
+    }
+    let mut candidates = Vec::new();
+    if let Ok(paths) = std::env::var("OFX_PLUGIN_PATH") {
+        candidates.extend(std::env::split_paths(&paths).map(|d| d.join(NAME)));
+    }
+    if let Some(dir) = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent().map(Path::to_path_buf))
+    {
+        // target/<profile>/morphfx → target/bundle/MorphFX.ofx.bundle (cargo xtask bundle),
+        // or the cdylib cargo left beside the binary.
+        candidates.push(dir.join("..").join("bundle").join(NAME));
+        candidates.push(dir.join("libmorphfx_ofx.so"));
+    }
+    candidates.push(PathBuf::from("/usr/OFX/Plugins").join(NAME));
+    candidates
+        .into_iter()
+        .find(|c| morphfx_harness::host::bundle_binary(c).is_file())
+        .ok_or_else(|| HostError::bad("no MorphFX bundle found: pass --bundle, set OFX_PLUGIN_PATH, or build one with `cargo xtask bundle`"))
+}
+
+/// A frame read from disk: its number, pixels and display-window size.
+type CachedPlate = (i64, Arc<Frame>, (usize, usize));
+
+/// Reads frames of a file or sequence on demand.
+struct Plates {
+    pattern: String,
+    cache: Mutex<Vec<CachedPlate>>,
+}
+
+impl Plates {
+    fn new(pattern: &str) -> Arc<Plates> {
+        Arc::new(Plates {
+            pattern: pattern.to_owned(),
+            cache: Mutex::new(Vec::new()),
+        })
+    }
+    fn plate(&self, frame: i64) -> Result<(Arc<Frame>, (usize, usize)), HostError> {
+        let frame = if is_sequence(&self.pattern) { frame } else { 0 };
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, f, size)) = cache.iter().find(|(k, _, _)| *k == frame) {
+            return Ok((f.clone(), *size));
+        }
+        let path = frame_path(&self.pattern, frame);
+        let plate = io::read(&path)?;
+        let f = Arc::new(Frame::from_image(&plate.image, "OfxBitDepthFloat", false));
+        cache.retain(|(k, _, _)| (k - frame).abs() <= 2);
+        cache.push((frame, f.clone(), plate.size));
+        Ok((f, plate.size))
+    }
+}
+
+impl FrameSource for Plates {
+    fn frame(&self, time: f64) -> Result<Arc<Frame>, String> {
+        self.plate(time.round() as i64)
+            .map(|(f, _)| f)
+            .map_err(|e| e.message)
+    }
+}
+
+struct Job {
+    plugin: &'static str,
+    context: &'static str,
+    sources: Vec<(String, String)>,
+    view: String,
+    /// Extra outputs: (view, path pattern).
+    extra: Vec<(String, String)>,
+    common: Common,
+}
+
+impl Job {
+    fn run(&self, bundle_path: &Path) -> Result<(), HostError> {
+        let c = &self.common;
+        let scene_text = std::fs::read_to_string(&c.scene)
+            .map_err(|e| HostError::bad(format!("scene {}: {e}", c.scene.display())))?;
+        let scene = Scene::parse(&scene_text)
+            .map_err(|e| HostError::bad(format!("scene {}: {e}", c.scene.display())))?;
+        if let Some(t) = c.t {
+            if !(0.0..=1.0).contains(&t) {
+                return Err(HostError::bad(format!("--t {t}: must be in [0, 1]")));
+            }
+        }
+        let frames = match &c.frames {
+            Some(spec) => parse_frames(spec)?,
+            None if self.sources.iter().any(|(_, p)| is_sequence(p)) || is_sequence(&c.output) => {
+                return Err(HostError::bad(
+                    "sequences need --frames (e.g. --frames 1001-1048)",
+                ))
+            }
+            None => vec![scene
+                .keyframes
+                .first()
+                .map(|k| k.frame)
+                .or(scene.progress.first().map(|p| p.0))
+                .unwrap_or(0.0) as i64],
+        };
+        let plates: Vec<(String, Arc<Plates>)> = self
+            .sources
+            .iter()
+            .map(|(clip, p)| (clip.clone(), Plates::new(p)))
+            .collect();
+        // Check every input frame up front: a missing or mismatched frame is
+        // reported before anything is written.
+        let mut size = (0, 0);
+        for &f in &frames {
+            let mut first: Option<(RectI, (usize, usize), String)> = None;
+            for (_, p) in &plates {
+                let (frame, s) = p.plate(f)?;
+                let name = frame_path(&p.pattern, f).display().to_string();
+                match &first {
+                    None => first = Some((frame.bounds, s, name)),
+                    Some((b, s0, n0)) if *s0 != s || *b != frame.bounds => {
+                        return Err(HostError::bad(format!(
+                            "size mismatch: {name} is {}x{} but {n0} is {}x{}",
+                            s.0, s.1, s0.0, s0.1
+                        )))
+                    }
+                    _ => {}
+                }
+                size = s;
+            }
+        }
+
+        let bundle = Bundle::load(bundle_path)?;
+        let inst = bundle.instance(self.plugin, self.context)?;
+        let scene_path = std::fs::canonicalize(&c.scene).unwrap_or_else(|_| c.scene.clone());
+        inst.set_string("scene_file", &scene_path.to_string_lossy())?;
+        if let Some(t) = c.t {
+            inst.set_double("progress", &[t], None)?;
+            inst.set_int("use_scene_progress", 0)?;
+        }
+        inst.set_project(size.0 as f64, size.1 as f64);
+        for (clip, p) in &plates {
+            inst.connect(clip, p.clone())?;
+        }
+        let precision = if c.half {
+            ExrPrecision::Half
+        } else {
+            ExrPrecision::Float
+        };
+        let outputs: Vec<(String, String)> = std::iter::once((self.view.clone(), c.output.clone()))
+            .chain(self.extra.iter().cloned())
+            .collect();
+        let progress = Progress::new(frames.len());
+        inst.begin_sequence(
+            frames[0] as f64,
+            *frames.last().unwrap_or(&frames[0]) as f64,
+        )?;
+        for (n, &f) in frames.iter().enumerate() {
+            for (view, pattern) in &outputs {
+                inst.set_choice("view", view)?;
+                let out = inst.render(f as f64, OutputSpec::default())?;
+                io::write(
+                    &frame_path(pattern, f),
+                    &Plate {
+                        image: out.to_image(),
+                        size,
+                    },
+                    precision,
+                )?;
+            }
+            progress.tick(n + 1, f);
+        }
+        inst.end_sequence(
+            frames[0] as f64,
+            *frames.last().unwrap_or(&frames[0]) as f64,
+        )?;
+        progress.done();
+        Ok(())
+    }
+}
+
+/// Frame n/N, fps and ETA on a terminal; plain lines otherwise.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    total: usize,
+    start: std::time::Instant,
+}
+
+impl Progress {
+    fn new(total: usize) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let b = indicatif::ProgressBar::new(total as u64);
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{bar:30} frame {pos}/{len}  {per_sec}  ETA {eta}  {msg}",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            b
+        });
+        Progress {
+            bar,
+            total,
+            start: std::time::Instant::now(),
+        }
+    }
+    fn tick(&self, n: usize, frame: i64) {
+        match &self.bar {
+            Some(b) => {
+                b.set_message(format!("(frame {frame})"));
+                b.set_position(n as u64);
+            }
+            None if self.total > 1 => {
+                let secs = self.start.elapsed().as_secs_f64();
+                let fps = n as f64 / secs.max(1e-9);
+                let eta = (self.total - n) as f64 / fps.max(1e-9);
+                eprintln!(
+                    "frame {n}/{} ({frame})  {fps:.2} fps  ETA {eta:.0}s",
+                    self.total
+                );
+            }
+            None => {}
+        }
+    }
+    fn done(&self) {
+        if let Some(b) = &self.bar {
+            b.finish();
+        }
+    }
+}
+
+/// Two procedural plates with recognisable features: a warm disc face on A,
+/// a cool rounded square face on B, eyes and mouth in different places.
+fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
+    let (w, h) = (320usize, 240usize);
+    let b = RectI::from_size(w, h);
+    let face = |i: i32, j: i32, c: usize, square: bool| -> f32 {
+        let (x, y) = (i as f32 + 0.5 - 160.0, j as f32 + 0.5 - 120.0);
+        let inside = if square {
+            x.abs().max(y.abs() * 1.1) < 85.0
+        } else {
+            (x * x + y * y).sqrt() < 90.0
+        };
+        let eyes = if square {
+            [(-35.0, 35.0), (35.0, 35.0)]
+        } else {
+            [(-30.0, 25.0), (30.0, 25.0)]
+        };
+        let eye = eyes
+            .iter()
+            .any(|(ex, ey)| ((x - ex).powi(2) + (y - ey).powi(2)).sqrt() < 9.0);
+        let mouth_y = if square { -40.0 } else { -35.0 };
+        let mouth = (y - mouth_y).abs() < 4.0 && x.abs() < if square { 45.0 } else { 35.0 };
+        let bg = [
+            0.05 + 0.2 * (j as f32 / h as f32),
+            0.08,
+            0.12 + 0.2 * (i as f32 / w as f32),
+            1.0,
+        ];
+        let skin = if square {
+            [0.3, 0.55, 0.9, 1.0]
+        } else {
+            [0.95, 0.6, 0.3, 1.0]
+        };
+        if eye || mouth {
+            [0.02, 0.02, 0.02, 1.0][c]
+        } else if inside {
+            skin[c] * (1.0 + 0.15 * ((x * 0.15).sin() * (y * 0.15).cos()))
+        } else {
+            bg[c]
+        }
+    };
+    let a = Image::from_fn(b, 4, |i, j, c| face(i, j, c, false));
+    let bb = Image::from_fn(b, 4, |i, j, c| face(i, j, c, true));
+    let plates = dir.join("plates");
+    io::write(
+        &plates.join("a.exr"),
+        &Plate {
+            image: a,
+            size: (w, h),
+        },
+        ExrPrecision::Float,
+    )?;
+    io::write(
+        &plates.join("b.exr"),
+        &Plate {
+            image: bb,
+            size: (w, h),
+        },
+        ExrPrecision::Float,
+    )?;
+    let (cx, cy) = (160.0, 120.0);
+    let scene = serde_json::json!({
+        "format": "morphfx-scene", "version": 1, "method": "field",
+        "field": { "a": 0.5, "b": 1.5, "p": 0.5, "interpolation": "endpoints" },
+        "features": [
+            { "name": "left eye", "type": "point", "a": [[cx - 30.0, cy + 25.0]], "b": [[cx - 35.0, cy + 35.0]] },
+            { "name": "right eye", "type": "point", "a": [[cx + 30.0, cy + 25.0]], "b": [[cx + 35.0, cy + 35.0]] },
+            { "name": "mouth", "type": "line", "a": [[cx - 35.0, cy - 35.0], [cx + 35.0, cy - 35.0]], "b": [[cx - 45.0, cy - 40.0], [cx + 45.0, cy - 40.0]] },
+            { "name": "top", "type": "line", "a": [[cx - 60.0, cy + 66.0], [cx + 60.0, cy + 66.0]], "b": [[cx - 80.0, cy + 77.0], [cx + 80.0, cy + 77.0]] },
+            { "name": "bottom", "type": "line", "a": [[cx + 60.0, cy - 66.0], [cx - 60.0, cy - 66.0]], "b": [[cx + 80.0, cy - 77.0], [cx - 80.0, cy - 77.0]] },
+            { "name": "left", "type": "line", "a": [[cx - 90.0, cy - 30.0], [cx - 90.0, cy + 30.0]], "b": [[cx - 85.0, cy - 40.0], [cx - 85.0, cy + 40.0]] },
+            { "name": "right", "type": "line", "a": [[cx + 90.0, cy + 30.0], [cx + 90.0, cy - 30.0]], "b": [[cx + 85.0, cy + 40.0], [cx + 85.0, cy - 40.0]] }
+        ],
+        "progress": [[1, 0.0], [12, 1.0]]
+    });
+    let scene_path = dir.join("demo.morph.json");
+    std::fs::write(
+        &scene_path,
+        serde_json::to_string_pretty(&scene).unwrap_or_default(),
+    )
+    .map_err(|e| HostError::failed(format!("{}: {e}", scene_path.display())))?;
+    let s = |p: PathBuf| p.to_string_lossy().into_owned();
+    let job = Job {
+        plugin: MORPH_ID,
+        context: "OfxImageEffectContextGeneral",
+        sources: vec![
+            ("SourceA".into(), s(plates.join("a.exr"))),
+            ("SourceB".into(), s(plates.join("b.exr"))),
+        ],
+        view: "morph".into(),
+        extra: vec![
+            ("morph".into(), s(dir.join("preview/morph.####.png"))),
+            ("stmap-a".into(), s(dir.join("stmap_a.####.exr"))),
+        ],
+        common: Common {
+            scene: scene_path.clone(),
+            t: None,
+            frames: Some("1-12".into()),
+            output: s(dir.join("morph.####.exr")),
+            half: false,
+        },
+    };
+    job.run(bundle_path)?;
+    println!(
+        "MorphFX demo rendered through {}",
+        morphfx_harness::host::bundle_binary(bundle_path).display()
+    );
+    println!("  plates:   {}", plates.display());
+    println!("  scene:    {}", scene_path.display());
+    println!(
+        "  morph:    {} (frames 1-12, float EXR)",
+        dir.join("morph.####.exr").display()
+    );
+    println!(
+        "  previews: {}",
+        dir.join("preview/morph.####.png").display()
+    );
+    println!(
+        "  ST maps:  {} (A's warp per frame)",
+        dir.join("stmap_a.####.exr").display()
+    );
+    Ok(())
+}

@@ -1,0 +1,230 @@
+//! End to end through the bundle's C ABI: the `morphfx` binary on generated
+//! EXR plates, checked against closed-form expectations.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use morphfx::geom::RectI;
+use morphfx::image::Image;
+use morphfx_harness::io::{self, ExrPrecision, Plate};
+
+fn bundle() -> PathBuf {
+    std::env::var("MORPHFX_BUNDLE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
+        })
+}
+
+fn morphfx(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
+        .arg("--bundle")
+        .arg(bundle())
+        .args(args)
+        .output()
+        .expect("morphfx runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("morphfx-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn plate(dir: &Path, name: &str, w: usize, h: usize, seed: f32) -> String {
+    let img = Image::from_fn(RectI::from_size(w, h), 4, |i, j, c| {
+        (i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin() * 2.0
+    });
+    let p = dir.join(name);
+    io::write(
+        &p,
+        &Plate {
+            image: img,
+            size: (w, h),
+        },
+        ExrPrecision::Float,
+    )
+    .unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+const TRANSLATE: &str = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
+  "field": {"a": 0.001, "b": 2, "p": 0.5, "evaluation": "exact"},
+  "features": [{"name": "bar", "type": "line", "a": [[10, 10], [40, 10]], "b": [[17, 5], [47, 5]]}]}"#;
+
+#[test]
+fn warp_stmap_of_one_translated_line_is_the_closed_form_translation() {
+    let d = tmp("stmap");
+    let a = plate(&d, "a.exr", 64, 48, 0.0);
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    let out = d.join("st.exr");
+    let (code, err) = morphfx(&[
+        "warp",
+        "--scene",
+        d.join("s.morph.json").to_str().unwrap(),
+        "--input",
+        &a,
+        "--t",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+        "--view",
+        "stmap",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let st = io::read(&out).unwrap().image;
+    // One line pair of equal length and direction is a pure translation: the
+    // output at X samples A at X - (7, -5).
+    for j in 0..48 {
+        for i in 0..64 {
+            let px = st.pixel(i, j);
+            let (sx, sy) = ((i as f32 + 0.5 - 7.0) / 64.0, (j as f32 + 0.5 + 5.0) / 48.0);
+            assert!(
+                (px[0] - sx).abs() < 1e-4 && (px[1] - sy).abs() < 1e-4,
+                "({i},{j}): {px:?}"
+            );
+            assert_eq!((px[2], px[3]), (0.0, 1.0));
+        }
+    }
+}
+
+#[test]
+fn morph_at_t0_is_a_and_at_t1_is_b_bit_for_bit() {
+    let d = tmp("ends");
+    let (a, b) = (
+        plate(&d, "a.exr", 40, 30, 0.0),
+        plate(&d, "b.exr", 40, 30, 1.7),
+    );
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    for (t, src) in [("0", &a), ("1", &b)] {
+        let out = d.join(format!("m{t}.exr"));
+        let (code, err) = morphfx(&[
+            "morph",
+            "--scene",
+            d.join("s.morph.json").to_str().unwrap(),
+            "--a",
+            &a,
+            "--b",
+            &b,
+            "--t",
+            t,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        assert_eq!(
+            io::read(&out).unwrap().image,
+            io::read(Path::new(src)).unwrap().image,
+            "t = {t}"
+        );
+    }
+}
+
+#[test]
+fn bad_scene_exits_2_naming_the_feature_and_writes_nothing() {
+    let d = tmp("bad");
+    let (a, b) = (
+        plate(&d, "a.exr", 16, 16, 0.0),
+        plate(&d, "b.exr", 16, 16, 1.0),
+    );
+    std::fs::write(
+        d.join("s.morph.json"),
+        r#"{"features": [{"name": "nose", "type": "line", "a": [[1,1],[2,2]], "b": [[1,1]]}]}"#,
+    )
+    .unwrap();
+    let out = d.join("m.exr");
+    let (code, err) = morphfx(&[
+        "morph",
+        "--scene",
+        d.join("s.morph.json").to_str().unwrap(),
+        "--a",
+        &a,
+        "--b",
+        &b,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("\"nose\"") && err.contains("a has 2 points but b has 1"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn size_mismatch_and_missing_frames_exit_2() {
+    let d = tmp("mismatch");
+    let (a, b) = (
+        plate(&d, "a.exr", 16, 16, 0.0),
+        plate(&d, "b.exr", 20, 16, 1.0),
+    );
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    let out = d.join("m.exr");
+    let (code, err) = morphfx(&[
+        "morph",
+        "--scene",
+        d.join("s.morph.json").to_str().unwrap(),
+        "--a",
+        &a,
+        "--b",
+        &b,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("size mismatch") && err.contains("b.exr"),
+        "{err}"
+    );
+    let seq = d.join("p.####.exr");
+    let (code, err) = morphfx(&[
+        "warp",
+        "--scene",
+        d.join("s.morph.json").to_str().unwrap(),
+        "--input",
+        seq.to_str().unwrap(),
+        "--frames",
+        "1-2",
+        "-o",
+        d.join("o.####.exr").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("p.0001.exr"), "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_panic_inside_the_plugin_becomes_a_failure_status_not_a_crash() {
+    let d = tmp("panic");
+    let a = plate(&d, "a.exr", 16, 16, 0.0);
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    let out = d.join("w.exr");
+    let status = Command::new(env!("CARGO_BIN_EXE_morphfx"))
+        .env("MORPHFX_FORCE_PANIC", "OfxImageEffectActionRender")
+        .args([
+            "--bundle",
+            bundle().to_str().unwrap(),
+            "warp",
+            "--scene",
+            d.join("s.morph.json").to_str().unwrap(),
+            "--input",
+            &a,
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&status.stderr);
+    assert_eq!(status.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("internal error") && err.contains("forced panic"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
