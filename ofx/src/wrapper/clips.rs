@@ -288,7 +288,7 @@ impl HostImage {
             return Err(bad("image has no pixel data"));
         }
         if info.row_bytes % size as isize != 0
-            || (info.data as usize) % std::mem::align_of::<T>() != 0
+            || !(info.data as usize).is_multiple_of(std::mem::align_of::<T>())
         {
             return Err(bad("image rows are not aligned to its pixel type"));
         }
