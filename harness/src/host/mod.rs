@@ -497,22 +497,23 @@ impl Instance<'_> {
         }
     }
 
-    pub fn begin_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
+    fn sequence_args(first: f64, last: f64) -> PropertySet {
         let a = PropertySet::new();
         a.set_double(kOfxImageEffectPropFrameRange, &[first, last]);
         a.set_double(kOfxImageEffectPropFrameStep, &[1.0]);
         a.set_int(kOfxPropIsInteractive, &[0]);
         a.set_double(kOfxImageEffectPropRenderScale, &[1.0, 1.0]);
+        a
+    }
+
+    pub fn begin_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
+        let a = Self::sequence_args(first, last);
         self.act(kOfxImageEffectActionBeginSequenceRender, Some(&a), None)
             .map(|_| ())
     }
 
     pub fn end_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
-        let a = PropertySet::new();
-        a.set_double(kOfxImageEffectPropFrameRange, &[first, last]);
-        a.set_double(kOfxImageEffectPropFrameStep, &[1.0]);
-        a.set_int(kOfxPropIsInteractive, &[0]);
-        a.set_double(kOfxImageEffectPropRenderScale, &[1.0, 1.0]);
+        let a = Self::sequence_args(first, last);
         self.act(kOfxImageEffectActionEndSequenceRender, Some(&a), None)
             .map(|_| ())
     }

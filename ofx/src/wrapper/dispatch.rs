@@ -6,7 +6,6 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Arc;
 
 use openfx::sys::generic::core::*;
-use openfx::sys::image_effect_v1::message::*;
 
 use super::clips::Effect;
 use super::{Failure, Outcome, BAD_INPUT_ID};
@@ -75,7 +74,6 @@ fn report(handle: *const c_void, action: &CStr, failure: &Failure) {
         Ok(effect) if !handle.is_null() => effect.error(id, text),
         _ => eprintln!("MorphFX: {}: {text}", action.to_string_lossy()),
     }
-    let _ = kOfxMessageError;
 }
 
 /// Stores `instance` in the effect's instance data (created in createInstance).
