@@ -1,1 +1,158 @@
-fn main() {}
+//! Core engine benchmarks (issue "core engine"): the field map at 1080p, resampling
+//! and a whole morph frame. Numbers and the machine go in docs/PERFORMANCE.md.
+//!
+//! `cargo bench --bench core` (add `-- field` etc. to pick a group).
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+
+use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::image::resample::{resample, ResampleSettings};
+use morphfx::image::{EdgeMode, Filter, Image, Sampler};
+use morphfx::morph::dissolve;
+use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
+use morphfx::warp::{Warp, WarpMap};
+
+const W: i32 = 1920;
+const H: i32 = 1080;
+
+fn frame() -> RectI {
+    RectI::new(0, 0, W, H)
+}
+
+/// Deterministic line pairs spread over the frame like a keyed face or body:
+/// 40-300 px long, each moved and turned a little between the two images.
+fn line_pairs(n: usize, seed: u64) -> Vec<LinePair> {
+    let mut s = seed;
+    let mut r = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| {
+            let p = Vec2::new(r() * W as f64, r() * H as f64);
+            let angle = r() * std::f64::consts::TAU;
+            let len = 40.0 + r() * 260.0;
+            let q = p + Vec2::new(angle.cos(), angle.sin()) * len;
+            let mut jitter = || Vec2::new(r() * 40.0 - 20.0, r() * 40.0 - 20.0);
+            let (jp, jq) = (jitter(), jitter());
+            LinePair {
+                dst: (p, q),
+                src: (p + jp, q + jq),
+            }
+        })
+        .collect()
+}
+
+fn field(n: usize, evaluation: Evaluation) -> FieldWarp {
+    let settings = FieldSettings {
+        evaluation,
+        ..FieldSettings::default()
+    };
+    FieldWarp::new(line_pairs(n, n as u64), &settings)
+}
+
+/// A plate with detail everywhere, so resampling cannot shortcut.
+fn plate(seed: f32) -> Image {
+    Image::from_fn(frame(), 4, |i, j, c| {
+        if c == 3 {
+            1.0
+        } else {
+            let (x, y) = (i as f32, j as f32);
+            0.5 + 0.5 * ((x * 0.05 + seed) * (c as f32 + 1.0)).sin() * (y * 0.031).cos()
+        }
+    })
+}
+
+fn bench_field(c: &mut Criterion) {
+    let mut g = c.benchmark_group("field_map_1080p");
+    g.sample_size(10).measurement_time(Duration::from_secs(8));
+    for n in [10, 100] {
+        let exact = field(n, Evaluation::Exact);
+        g.bench_function(format!("exact_{n}_lines"), |b| {
+            b.iter(|| black_box(exact.map_window(frame(), PixelScale::UNIT)))
+        });
+        let adaptive = field(n, Evaluation::default());
+        g.bench_function(format!("adaptive_{n}_lines"), |b| {
+            b.iter(|| black_box(adaptive.map_window(frame(), PixelScale::UNIT)))
+        });
+    }
+    g.finish();
+}
+
+fn bench_resample(c: &mut Criterion) {
+    let src = plate(0.0);
+    let map: WarpMap = field(100, Evaluation::default()).map_window(frame(), PixelScale::UNIT);
+    let mut dst = Image::new(frame(), 4);
+    let mut g = c.benchmark_group("resample_1080p_rgba_f32");
+    g.sample_size(20);
+    // The memory floor: one plain copy of a frame (read 33 MB, write 33 MB),
+    // rows in parallel as the resampler writes them.
+    g.bench_function("copy_floor", |b| {
+        b.iter(|| {
+            use rayon::prelude::*;
+            dst.data
+                .par_chunks_mut(W as usize * 4)
+                .zip(src.data.par_chunks(W as usize * 4))
+                .for_each(|(d, s)| d.copy_from_slice(s))
+        })
+    });
+    for filter in [Filter::Bilinear, Filter::Bicubic] {
+        let settings = ResampleSettings {
+            filter,
+            edge: EdgeMode::Clamp,
+            premultiplied: true,
+        };
+        g.bench_function(filter.name(), |b| {
+            b.iter(|| {
+                resample(
+                    src.view(),
+                    PixelScale::UNIT,
+                    &map,
+                    dst.view_mut().rows(),
+                    settings,
+                )
+            })
+        });
+    }
+    g.finish();
+}
+
+fn bench_morph(c: &mut Criterion) {
+    let (a, b) = (plate(0.0), plate(1.7));
+    // The cached warps: what a host's second render of the frame reuses.
+    let warp_a = field(100, Evaluation::default());
+    let mut warp_b = field(100, Evaluation::default());
+    // B's warp pulls the other way.
+    warp_b = FieldWarp::new(
+        warp_b
+            .pairs()
+            .iter()
+            .map(|l| LinePair {
+                dst: l.src,
+                src: l.dst,
+            })
+            .collect(),
+        &FieldSettings::default(),
+    );
+    let map_a = warp_a.map_window(frame(), PixelScale::UNIT);
+    let map_b = warp_b.map_window(frame(), PixelScale::UNIT);
+    let mut dst = Image::new(frame(), 4);
+    let mut g = c.benchmark_group("morph_frame_1080p_rgba_f32");
+    g.sample_size(20);
+    for filter in [Filter::Bilinear, Filter::Bicubic] {
+        let sa = Sampler::new(a.view(), PixelScale::UNIT, filter, EdgeMode::Clamp, true);
+        let sb = Sampler::new(b.view(), PixelScale::UNIT, filter, EdgeMode::Clamp, true);
+        g.bench_function(format!("cached_warp_{}", filter.name()), |bch| {
+            bch.iter(|| dissolve(&sa, &map_a, &sb, &map_b, 0.37, dst.view_mut().rows()))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_field, bench_resample, bench_morph);
+criterion_main!(benches);

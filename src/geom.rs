@@ -10,12 +10,14 @@ pub struct Vec2 {
 }
 
 impl From<[f64; 2]> for Vec2 {
+    #[inline]
     fn from([x, y]: [f64; 2]) -> Self {
         Vec2 { x, y }
     }
 }
 
 impl From<Vec2> for [f64; 2] {
+    #[inline]
     fn from(v: Vec2) -> Self {
         [v.x, v.y]
     }
@@ -27,26 +29,33 @@ impl Vec2 {
     pub const fn new(x: f64, y: f64) -> Self {
         Vec2 { x, y }
     }
+    #[inline]
     pub fn dot(self, o: Vec2) -> f64 {
         self.x * o.x + self.y * o.y
     }
     /// The left perpendicular, same length (Beier-Neely's `Perpendicular()`; any
     /// consistent choice works, we take the counter-clockwise one).
+    #[inline]
     pub fn perp(self) -> Vec2 {
         Vec2::new(-self.y, self.x)
     }
+    #[inline]
     pub fn length_squared(self) -> f64 {
         self.dot(self)
     }
+    #[inline]
     pub fn length(self) -> f64 {
         self.length_squared().sqrt()
     }
+    #[inline]
     pub fn lerp(self, o: Vec2, t: f64) -> Vec2 {
         Vec2::new(self.x + (o.x - self.x) * t, self.y + (o.y - self.y) * t)
     }
+    #[inline]
     pub fn is_finite(self) -> bool {
         self.x.is_finite() && self.y.is_finite()
     }
+    #[inline]
     pub fn distance(self, o: Vec2) -> f64 {
         (self - o).length()
     }
@@ -54,11 +63,13 @@ impl Vec2 {
 
 impl Add for Vec2 {
     type Output = Vec2;
+    #[inline]
     fn add(self, o: Vec2) -> Vec2 {
         Vec2::new(self.x + o.x, self.y + o.y)
     }
 }
 impl AddAssign for Vec2 {
+    #[inline]
     fn add_assign(&mut self, o: Vec2) {
         self.x += o.x;
         self.y += o.y;
@@ -66,24 +77,28 @@ impl AddAssign for Vec2 {
 }
 impl Sub for Vec2 {
     type Output = Vec2;
+    #[inline]
     fn sub(self, o: Vec2) -> Vec2 {
         Vec2::new(self.x - o.x, self.y - o.y)
     }
 }
 impl Mul<f64> for Vec2 {
     type Output = Vec2;
+    #[inline]
     fn mul(self, s: f64) -> Vec2 {
         Vec2::new(self.x * s, self.y * s)
     }
 }
 impl Div<f64> for Vec2 {
     type Output = Vec2;
+    #[inline]
     fn div(self, s: f64) -> Vec2 {
         Vec2::new(self.x / s, self.y / s)
     }
 }
 impl Neg for Vec2 {
     type Output = Vec2;
+    #[inline]
     fn neg(self) -> Vec2 {
         Vec2::new(-self.x, -self.y)
     }
@@ -105,18 +120,23 @@ impl RectI {
     pub const fn from_size(width: usize, height: usize) -> Self {
         RectI::new(0, 0, width as i32, height as i32)
     }
+    #[inline]
     pub fn width(&self) -> usize {
         (self.x2 - self.x1).max(0) as usize
     }
+    #[inline]
     pub fn height(&self) -> usize {
         (self.y2 - self.y1).max(0) as usize
     }
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.width() == 0 || self.height() == 0
     }
+    #[inline]
     pub fn area(&self) -> usize {
         self.width() * self.height()
     }
+    #[inline]
     pub fn contains(&self, other: &RectI) -> bool {
         other.is_empty()
             || (self.x1 <= other.x1
@@ -124,6 +144,7 @@ impl RectI {
                 && other.x2 <= self.x2
                 && other.y2 <= self.y2)
     }
+    #[inline]
     pub fn intersect(&self, o: &RectI) -> RectI {
         let r = RectI::new(
             self.x1.max(o.x1),
@@ -151,6 +172,7 @@ pub struct PixelScale {
 impl PixelScale {
     pub const UNIT: PixelScale = PixelScale { x: 1.0, y: 1.0 };
 
+    #[inline]
     pub fn new(render_scale_x: f64, render_scale_y: f64, pixel_aspect: f64) -> Self {
         PixelScale {
             x: render_scale_x / pixel_aspect,
@@ -158,12 +180,15 @@ impl PixelScale {
         }
     }
     /// Canonical position of the centre of pixel `(i, j)`.
+    #[inline]
     pub fn pixel_centre(&self, i: i32, j: i32) -> Vec2 {
         Vec2::new((i as f64 + 0.5) / self.x, (j as f64 + 0.5) / self.y)
     }
+    #[inline]
     pub fn to_pixel(&self, p: Vec2) -> Vec2 {
         Vec2::new(p.x * self.x, p.y * self.y)
     }
+    #[inline]
     pub fn is_unit(&self) -> bool {
         *self == PixelScale::UNIT
     }

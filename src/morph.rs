@@ -1,7 +1,8 @@
 //! The in-between image: both sources warped toward the same feature positions
 //! and dissolved (seed 002 §3.4).
 
-use crate::image::{resample::adapt_channels, resample::fill, RowsMut, Sample, Sampler};
+use crate::image::resample::{adapt_channels, fill_rows, row_through};
+use crate::image::{RowsMut, Sample, Sampler};
 use crate::warp::WarpMap;
 
 /// `dst = (1 − t) · A(map_a) + t · B(map_b)`, in `dst`'s channel layout.
@@ -18,23 +19,29 @@ pub fn dissolve<S: Sample, D: Sample>(
     let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
     let (ca, cb) = (a.channels(), b.channels());
-    fill(dst, dc, |i, j, px| {
-        let mut sa = [0f32; 4];
-        let mut sb = [0f32; 4];
-        if wa != 0.0 {
-            crate::image::resample::sample_through(a, map_a, i, j, &mut sa);
-            sa = adapt_channels(ca, dc, sa);
-        }
-        if wb != 0.0 {
-            crate::image::resample::sample_through(b, map_b, i, j, &mut sb);
-            sb = adapt_channels(cb, dc, sb);
-        }
-        for c in 0..4 {
-            px[c] = match (wa != 0.0, wb != 0.0) {
-                (true, false) => sa[c],
-                (false, true) => sb[c],
-                _ => wa * sa[c] + wb * sb[c],
+    fill_rows(dst, dc, |j, x1, row| {
+        let warped =
+            |sampler: &Sampler<'_, S>, map: &WarpMap, channels: usize, out: &mut [[f32; 4]]| {
+                row_through(sampler, map, j, x1, out);
+                if channels != dc {
+                    for px in out.iter_mut() {
+                        *px = adapt_channels(channels, dc, *px);
+                    }
+                }
             };
+        if wb == 0.0 {
+            warped(a, map_a, ca, row);
+        } else if wa == 0.0 {
+            warped(b, map_b, cb, row);
+        } else {
+            let mut other = vec![[0f32; 4]; row.len()];
+            warped(a, map_a, ca, row);
+            warped(b, map_b, cb, &mut other);
+            for (pa, pb) in row.iter_mut().zip(&other) {
+                for c in 0..4 {
+                    pa[c] = wa * pa[c] + wb * pb[c];
+                }
+            }
         }
     });
 }

@@ -75,10 +75,12 @@ impl Layout {
         }
     }
 
+    #[inline]
     fn row_start(&self, j: i32) -> usize {
         (self.base as isize + (j - self.bounds.y1) as isize * self.row_stride) as usize
     }
 
+    #[inline]
     fn row_len(&self) -> usize {
         self.bounds.width() * self.channels
     }
@@ -121,9 +123,11 @@ impl<'a, T: Sample> ImageView<'a, T> {
         layout.check(data.len())?;
         Ok(ImageView { data, layout })
     }
+    #[inline]
     pub fn bounds(&self) -> RectI {
         self.layout.bounds
     }
+    #[inline]
     pub fn channels(&self) -> usize {
         self.layout.channels
     }
@@ -153,9 +157,11 @@ impl<'a, T: Sample> ImageViewMut<'a, T> {
         layout.check(data.len())?;
         Ok(ImageViewMut { data, layout })
     }
+    #[inline]
     pub fn bounds(&self) -> RectI {
         self.layout.bounds
     }
+    #[inline]
     pub fn channels(&self) -> usize {
         self.layout.channels
     }
@@ -236,9 +242,11 @@ impl Image {
         }
         img
     }
+    #[inline]
     pub fn width(&self) -> usize {
         self.bounds.width()
     }
+    #[inline]
     pub fn height(&self) -> usize {
         self.bounds.height()
     }
@@ -252,6 +260,7 @@ impl Image {
         let layout = self.layout();
         ImageViewMut::new(&mut self.data, layout).expect("packed layout fits its buffer")
     }
+    #[inline]
     pub fn pixel(&self, i: i32, j: i32) -> &[f32] {
         let k = ((j - self.bounds.y1) as usize * self.width() + (i - self.bounds.x1) as usize)
             * self.channels;

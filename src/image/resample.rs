@@ -26,23 +26,53 @@ pub fn fill<D: Sample>(
     src_channels: usize,
     f: impl Fn(i32, i32, &mut [f32; 4]) + Sync,
 ) {
+    fill_rows(dst, src_channels, |j, x1, row| {
+        for (k, px) in row.iter_mut().enumerate() {
+            f(x1 + k as i32, j, px);
+        }
+    });
+}
+
+/// Row-at-a-time [`fill`]: `f(j, x1, row)` computes the pixels `x1..` of row `j`
+/// into `row` (in `src_channels` layout), which is then stored into `dst`.
+pub fn fill_rows<D: Sample>(
+    dst: RowsMut<'_, D>,
+    src_channels: usize,
+    f: impl Fn(i32, i32, &mut [[f32; 4]]) + Sync,
+) {
     let b = dst.bounds;
     let dc = dst.channels;
-    let work = |(j, row): (i32, &mut [D])| {
-        let mut px = [0f32; 4];
-        for (k, out) in row.chunks_exact_mut(dc).enumerate() {
-            f(b.x1 + k as i32, j, &mut px);
-            let v = adapt_channels(src_channels, dc, px);
-            for (o, v) in out.iter_mut().zip(v) {
-                *o = D::from_f32(v);
-            }
-        }
+    let work = |scratch: &mut Vec<[f32; 4]>, (j, row): (i32, &mut [D])| {
+        scratch.clear();
+        scratch.resize(b.width(), [0.0; 4]);
+        f(j, b.x1, scratch);
+        store(src_channels, dc, scratch, row);
     };
     let rows = dst.rows;
     if b.area() >= PARALLEL_MIN_PIXELS {
-        rows.into_par_iter().for_each(work);
+        rows.into_par_iter().for_each_init(Vec::new, work);
     } else {
-        rows.into_iter().for_each(work);
+        let mut scratch = Vec::new();
+        rows.into_iter().for_each(|r| work(&mut scratch, r));
+    }
+}
+
+/// Converts a row of `from`-channel pixels into `to`-channel samples.
+fn store<D: Sample>(from: usize, to: usize, px: &[[f32; 4]], row: &mut [D]) {
+    let pixels = row.chunks_exact_mut(to).zip(px);
+    if from == to {
+        // The common case: no layout change, one branch-free loop.
+        for (out, v) in pixels {
+            for (o, v) in out.iter_mut().zip(v) {
+                *o = D::from_f32(*v);
+            }
+        }
+    } else {
+        for (out, v) in pixels {
+            for (o, v) in out.iter_mut().zip(adapt_channels(from, to, *v)) {
+                *o = D::from_f32(v);
+            }
+        }
     }
 }
 
@@ -82,25 +112,45 @@ pub fn resample<S: Sample, D: Sample>(
 
 /// `dst(i, j) = sampler(map(i, j))`.
 pub fn through<S: Sample, D: Sample>(sampler: &Sampler<'_, S>, map: &WarpMap, dst: RowsMut<'_, D>) {
-    fill(dst, sampler.channels(), |i, j, px| {
-        sample_through(sampler, map, i, j, px);
+    fill_rows(dst, sampler.channels(), |j, x1, row| {
+        row_through(sampler, map, j, x1, row);
     });
 }
 
-/// One output pixel of `sampler` seen through `map`.
-#[inline]
-pub(crate) fn sample_through<S: Sample>(
+/// Row `j` of `sampler` seen through `map`, pixels `x1..x1 + row.len()`;
+/// pixels outside the map's window are transparent black.
+pub(crate) fn row_through<S: Sample>(
     sampler: &Sampler<'_, S>,
     map: &WarpMap,
-    i: i32,
     j: i32,
-    px: &mut [f32; 4],
+    x1: i32,
+    row: &mut [[f32; 4]],
 ) {
     let w = map.window;
-    if i < w.x1 || i >= w.x2 || j < w.y1 || j >= w.y2 {
-        *px = [0.0; 4];
+    let x2 = x1 + row.len() as i32;
+    let (lo, hi) = (x1.max(w.x1), x2.min(w.x2));
+    if j < w.y1 || j >= w.y2 || lo >= hi {
+        row.fill([0.0; 4]);
         return;
     }
-    let p = map.get(i, j);
-    sampler.sample(p.x as f32, p.y as f32, px);
+    let (before, rest) = row.split_at_mut((lo - x1) as usize);
+    let (inside, after) = rest.split_at_mut((hi - lo) as usize);
+    before.fill([0.0; 4]);
+    after.fill([0.0; 4]);
+    match map.row(j) {
+        Some(positions) => {
+            let span = &positions[(lo - w.x1) as usize..(hi - w.x1) as usize];
+            sampler.sample_row(span, inside);
+        }
+        None => {
+            let s = map.scale;
+            let centres: Vec<[f32; 2]> = (lo..hi)
+                .map(|i| {
+                    let c = s.pixel_centre(i, j);
+                    [c.x as f32, c.y as f32]
+                })
+                .collect();
+            sampler.sample_row(&centres, inside);
+        }
+    }
 }

@@ -34,11 +34,13 @@ impl WarpMap {
         }
     }
 
+    #[inline]
     pub fn is_identity(&self) -> bool {
         self.identity
     }
 
     /// Canonical source position for output pixel `(i, j)` (inside `window`).
+    #[inline]
     pub fn get(&self, i: i32, j: i32) -> Vec2 {
         if self.identity {
             return self.scale.pixel_centre(i, j);
@@ -49,6 +51,7 @@ impl WarpMap {
     }
 
     /// One row of positions (`None` for the identity map).
+    #[inline]
     pub fn row(&self, j: i32) -> Option<&[[f32; 2]]> {
         if self.identity {
             return None;

@@ -93,7 +93,7 @@ pub fn action(
     } else if is(action, kOfxImageEffectActionGetRegionOfDefinition) {
         render::region_of_definition(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionGetRegionsOfInterest) {
-        render::regions_of_interest(kind, &effect, &out_props()?)?;
+        render::regions_of_interest(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionGetFramesNeeded) {
         render::frames_needed(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionRender) {

@@ -78,18 +78,24 @@ pub fn region_of_definition(
     )
 }
 
-/// A warp can pull from anywhere: ask for each source's whole region.
-pub fn regions_of_interest(kind: NodeKind, effect: &Effect, out_args: &PropSet) -> Outcome {
+/// A warp can pull from anywhere: ask for each source's whole region, at the
+/// frame (offset included) that source is read for this render.
+pub fn regions_of_interest(
+    kind: NodeKind,
+    effect: &Effect,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
     let context = context(effect);
     let (a, b) = kind.source_clips(&context);
-    for name in std::iter::once(a).chain(b) {
+    let (oa, ob) = offsets(kind, effect, time);
+    for (name, offset) in std::iter::once((a, oa)).chain(b.map(|b| (b, ob))) {
         let clip = effect.clip(name)?;
         if !clip.is_connected() {
             continue;
         }
-        // The RoI is time independent here; use the clip's RoD at time 0's
-        // neighbourhood through the host (any time gives the plate's extent).
-        if let Ok(rod) = clip.rod(0.0) {
+        if let Ok(rod) = clip.rod(time + offset) {
             let prop =
                 std::ffi::CString::new(format!("OfxImageClipPropRoI_{name}")).unwrap_or_default();
             out_args.set_doubles(&prop, &[rod.x1, rod.y1, rod.x2, rod.y2])?;

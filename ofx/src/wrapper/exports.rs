@@ -81,14 +81,44 @@ pub unsafe extern "C" fn OfxSetHost(host: *const OfxHost) -> OfxStatus {
     }
 }
 
+/// Whether this CPU runs the instructions the bundle was built for
+/// (`.cargo/config.toml`: x86-64-v3, AVX2 + FMA). On an older CPU the bundle
+/// offers no plugins, with a message, instead of faulting inside the host.
+fn cpu_supported() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        static OK: OnceLock<bool> = OnceLock::new();
+        *OK.get_or_init(|| {
+            let ok = std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma");
+            if !ok {
+                eprintln!("MorphFX: this CPU lacks AVX2/FMA (x86-64-v3); no plugins offered");
+            }
+            ok
+        })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    true
+}
+
 #[unsafe(no_mangle)]
 pub extern "C" fn OfxGetNumberOfPlugins() -> c_int {
-    std::panic::catch_unwind(|| statics().plugins.len() as c_int).unwrap_or(0)
+    std::panic::catch_unwind(|| {
+        if cpu_supported() {
+            statics().plugins.len() as c_int
+        } else {
+            0
+        }
+    })
+    .unwrap_or(0)
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn OfxGetPlugin(nth: c_int) -> *mut OfxPlugin {
     std::panic::catch_unwind(|| {
+        if !cpu_supported() {
+            return std::ptr::null_mut();
+        }
         let plugins = &statics().plugins;
         match usize::try_from(nth).ok().and_then(|i| plugins.get(i)) {
             // The host only reads through this pointer.

@@ -34,10 +34,26 @@ pub(super) struct Lines {
 
 impl Lines {
     pub fn new(pairs: &[LinePair], weight: &Weight) -> Self {
+        let n = pairs.len();
+        let v = || Vec::with_capacity(n);
         let mut l = Lines {
+            px: v(),
+            py: v(),
+            qx: v(),
+            qy: v(),
+            dx: v(),
+            dy: v(),
+            inv_len2: v(),
+            inv_len: v(),
+            spx: v(),
+            spy: v(),
+            ex: v(),
+            ey: v(),
+            nx: v(),
+            ny: v(),
+            len_p: v(),
             a: weight.a as f32,
             exponent: Some(weight.exponent()),
-            ..Default::default()
         };
         for pair in pairs {
             let (p, q) = pair.dst;
@@ -64,49 +80,103 @@ impl Lines {
         l
     }
 
+    /// Positions `(x, y) + Σ w·(X′ − X) / Σ w` over these lines.
     pub fn map_points(&self, xs: &[f32], ys: &[f32], out_x: &mut [f32], out_y: &mut [f32]) {
+        let zero = Sums::default();
+        self.map_points_plus(xs, ys, |_| zero, out_x, out_y);
+    }
+
+    /// Like [`Lines::map_points`], with `base(k)` (sums of other lines,
+    /// eight points from `k` on) added before dividing.
+    pub fn map_points_plus(
+        &self,
+        xs: &[f32],
+        ys: &[f32],
+        base: impl Fn(usize) -> Sums,
+        out_x: &mut [f32],
+        out_y: &mut [f32],
+    ) {
+        self.each8(xs, ys, base, |k, take, x, y, s| {
+            // Far from every line a steep falloff can underflow all weights: hold still there.
+            let ok = s.w.simd_gt(f32x8::ZERO);
+            let inv = ok.select(f32x8::ONE / s.w, f32x8::ZERO);
+            out_x[k..k + take].copy_from_slice(&(x + s.x * inv).to_array()[..take]);
+            out_y[k..k + take].copy_from_slice(&(y + s.y * inv).to_array()[..take]);
+        });
+    }
+
+    /// The weighted sums themselves, `[Σ w·Δx, Σ w·Δy, Σ w]` per point (for
+    /// interpolating the far field).
+    pub fn sums(&self, xs: &[f32], ys: &[f32], out: &mut [[f32; 3]]) {
+        let zero = Sums::default();
+        self.each8(
+            xs,
+            ys,
+            |_| zero,
+            |k, take, _, _, s| {
+                let (x, y, w) = (s.x.to_array(), s.y.to_array(), s.w.to_array());
+                for l in 0..take {
+                    out[k + l] = [x[l], y[l], w[l]];
+                }
+            },
+        );
+    }
+
+    /// Runs the kernel over points eight at a time: `sink(k, take, x, y, sums)`.
+    fn each8(
+        &self,
+        xs: &[f32],
+        ys: &[f32],
+        base: impl Fn(usize) -> Sums,
+        mut sink: impl FnMut(usize, usize, f32x8, f32x8, Sums),
+    ) {
         // Dispatch once on the exponent so the inner loop has no branch on it.
         match self.exponent.unwrap_or(Exponent::One) {
-            Exponent::Zero => self.run(|_| f32x8::ONE, xs, ys, out_x, out_y),
-            Exponent::Half => self.run(|r| r.sqrt(), xs, ys, out_x, out_y),
-            Exponent::One => self.run(|r| r, xs, ys, out_x, out_y),
-            Exponent::Two => self.run(|r| r * r, xs, ys, out_x, out_y),
+            Exponent::Zero => self.run(|_| f32x8::ONE, xs, ys, base, &mut sink),
+            Exponent::Half => self.run(|r| r.sqrt(), xs, ys, base, &mut sink),
+            Exponent::One => self.run(|r| r, xs, ys, base, &mut sink),
+            Exponent::Two => self.run(|r| r * r, xs, ys, base, &mut sink),
             Exponent::General(b) => {
                 let b = f32x8::splat(b);
-                self.run(move |r| (r.ln() * b).exp(), xs, ys, out_x, out_y)
+                self.run(move |r| (r.ln() * b).exp(), xs, ys, base, &mut sink)
             }
         }
     }
 
+    #[inline(always)]
     fn run<F: Fn(f32x8) -> f32x8>(
         &self,
         pow: F,
         xs: &[f32],
         ys: &[f32],
-        out_x: &mut [f32],
-        out_y: &mut [f32],
+        base: impl Fn(usize) -> Sums,
+        sink: &mut impl FnMut(usize, usize, f32x8, f32x8, Sums),
     ) {
         let n = xs.len();
-        let mut i = 0;
-        while i < n {
-            let take = (n - i).min(8);
+        let mut k = 0;
+        while k < n {
+            let take = (n - k).min(8);
             let mut bx = [0f32; 8];
             let mut by = [0f32; 8];
-            bx[..take].copy_from_slice(&xs[i..i + take]);
-            by[..take].copy_from_slice(&ys[i..i + take]);
-            let (mx, my) = self.eval8(&pow, f32x8::new(bx), f32x8::new(by));
-            out_x[i..i + take].copy_from_slice(&mx.to_array()[..take]);
-            out_y[i..i + take].copy_from_slice(&my.to_array()[..take]);
-            i += take;
+            bx[..take].copy_from_slice(&xs[k..k + take]);
+            by[..take].copy_from_slice(&ys[k..k + take]);
+            let (x, y) = (f32x8::new(bx), f32x8::new(by));
+            let sums = self.sums8(&pow, x, y, base(k));
+            sink(k, take, x, y, sums);
+            k += take;
         }
     }
 
     #[inline(always)]
-    fn eval8<F: Fn(f32x8) -> f32x8>(&self, pow: &F, x: f32x8, y: f32x8) -> (f32x8, f32x8) {
+    fn sums8<F: Fn(f32x8) -> f32x8>(&self, pow: &F, x: f32x8, y: f32x8, init: Sums) -> Sums {
         let zero = f32x8::ZERO;
         let one = f32x8::ONE;
         let a = f32x8::splat(self.a);
-        let (mut sx, mut sy, mut ws) = (zero, zero, zero);
+        let Sums {
+            x: mut sx,
+            y: mut sy,
+            w: mut ws,
+        } = init;
         let s = f32x8::splat;
         for k in 0..self.px.len() {
             let rx = x - s(self.px[k]);
@@ -126,9 +196,18 @@ impl Lines {
             sy += (ty - y) * w;
             ws += w;
         }
-        // Far from every line a steep falloff can underflow all weights: hold still there.
-        let ok = ws.simd_gt(zero);
-        let inv = ok.select(one / ws, zero);
-        (x + sx * inv, y + sy * inv)
+        Sums {
+            x: sx,
+            y: sy,
+            w: ws,
+        }
     }
+}
+
+/// `Σ w·(X′ − X)` per axis and `Σ w` for eight points (or one, in lane 0).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Sums {
+    pub x: f32x8,
+    pub y: f32x8,
+    pub w: f32x8,
 }

@@ -3,13 +3,14 @@
 
 mod kernel;
 mod lines;
+pub mod split;
 pub mod weight;
 
 pub use lines::{interpolate_line, line_pairs_toward, LinePair};
 
 use crate::features::{Feature, Side};
 use crate::geom::{PixelScale, RectI, Vec2};
-use crate::warp::{adaptive, Warp, WarpMap};
+use crate::warp::{Warp, WarpMap};
 use weight::Weight;
 
 /// How lines move from their A to their B position over `t` (seed 002 §3.4).
@@ -180,11 +181,7 @@ impl Warp for FieldWarp {
         match self.evaluation {
             _ if self.identity => WarpMap::identity(window, scale),
             Evaluation::Exact => exact_map_window(self, window, scale),
-            Evaluation::Adaptive { tolerance } => {
-                // Lines are where the field creases: refine around them always.
-                let creases: Vec<_> = self.pairs.iter().map(|l| l.dst).collect();
-                adaptive::map_window(self, window, scale, tolerance, &creases)
-            }
+            Evaluation::Adaptive { tolerance } => split::map_window(self, window, scale, tolerance),
         }
     }
 }

@@ -210,6 +210,65 @@ fn adaptive_mode_stays_within_its_tolerance_on_random_line_sets() {
     }
 }
 
+/// Long lines spread over a wide frame, many of them: every block mixes
+/// near and far lines, the case the adaptive split exists for.
+fn spread_pairs(seed: u64, n: usize, w: f64, h: f64) -> Vec<LinePair> {
+    let mut s = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut r = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| {
+            let p = v(r() * w, r() * h);
+            let angle = r() * std::f64::consts::TAU;
+            let len = 20.0 + r() * 150.0;
+            let q = p + v(angle.cos(), angle.sin()) * len;
+            let mut jitter = || v(r() * 30.0 - 15.0, r() * 30.0 - 15.0);
+            let (jp, jq) = (jitter(), jitter());
+            LinePair {
+                dst: (p, q),
+                src: (p + jp, q + jq),
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn adaptive_mode_stays_within_its_tolerance_on_dense_line_sets_and_proxy_scale() {
+    let tolerance = Evaluation::DEFAULT_TOLERANCE;
+    for (seed, n, scale) in [(1, 40, 1.0), (2, 60, 1.0), (3, 40, 0.5)] {
+        let pairs = spread_pairs(seed, n, 640.0, 360.0);
+        let scale = PixelScale::new(scale, scale, 1.0);
+        let window = RectI::new(0, 0, (640.0 * scale.x) as i32, (360.0 * scale.y) as i32);
+        let exact_warp = FieldWarp::new(pairs.clone(), &exact(0.001));
+        let adaptive = FieldWarp::new(
+            pairs,
+            &FieldSettings {
+                evaluation: Evaluation::Adaptive { tolerance },
+                ..exact(0.001)
+            },
+        );
+        let e = exact_warp.map_window(window, scale);
+        let a = adaptive.map_window(window, scale);
+        let mut worst = 0.0f64;
+        for j in window.y1..window.y2 {
+            for i in window.x1..window.x2 {
+                // Error in output pixels at this scale.
+                let (pe, pa) = (scale.to_pixel(e.get(i, j)), scale.to_pixel(a.get(i, j)));
+                worst = worst.max(pe.distance(pa));
+            }
+        }
+        assert!(
+            worst <= tolerance,
+            "seed {seed}, {n} lines, scale {}: adaptive error {worst} px > {tolerance}",
+            scale.x
+        );
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     /// Warping A all the way (t = 1) brings A's line endpoints onto B's.
