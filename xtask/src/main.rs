@@ -45,6 +45,14 @@ fn bundle(release: bool) -> PathBuf {
     let plist =
         std::fs::read_to_string(root().join("bundle/Info.plist")).expect("bundle/Info.plist");
     std::fs::write(bundle.join("Contents").join("Info.plist"), plist).expect("write Info.plist");
+    // Node icons, named by plugin identifier as hosts look them up.
+    let resources = bundle.join("Contents").join("Resources");
+    std::fs::create_dir_all(&resources).expect("create Resources");
+    for icon in std::fs::read_dir(root().join("bundle/Resources")).expect("bundle/Resources") {
+        let icon = icon.expect("list bundle/Resources").path();
+        let name = icon.file_name().expect("a file name").to_owned();
+        std::fs::copy(&icon, resources.join(name)).expect("copy an icon");
+    }
     bundle
 }
 
@@ -81,6 +89,7 @@ fn main() {
             let mut run = vec!["test", "--workspace"];
             run.extend(args[1..].iter().map(String::as_str));
             cargo(&run);
+            cmake_install_check();
         }
         _ => {
             eprintln!(
@@ -89,6 +98,84 @@ fn main() {
             exit(2);
         }
     }
+}
+
+/// `cmake -S . -B build && cmake --build build && cmake --install build --prefix P`
+/// must leave a bundle under `P/OFX/Plugins` that a host can load: checked by
+/// listing its plugins through the C ABI with `morphfx plugins`.
+fn cmake_install_check() {
+    let have_cmake = Command::new("cmake")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !have_cmake {
+        println!("cmake install check: skipped (cmake is not installed)");
+        return;
+    }
+    let dir = root().join("target").join("cmake-check");
+    let _ = std::fs::remove_dir_all(dir.join("prefix"));
+    let (build, prefix) = (dir.join("build"), dir.join("prefix"));
+    let run = |args: &[&std::ffi::OsStr]| {
+        let status = Command::new("cmake")
+            .args(args)
+            .current_dir(root())
+            .status()
+            .expect("cmake runs");
+        if !status.success() {
+            eprintln!("cmake install check failed: cmake {args:?}");
+            exit(1);
+        }
+    };
+    run(&[
+        "-S".as_ref(),
+        ".".as_ref(),
+        "-B".as_ref(),
+        build.as_os_str(),
+    ]);
+    run(&["--build".as_ref(), build.as_os_str()]);
+    run(&[
+        "--install".as_ref(),
+        build.as_os_str(),
+        "--prefix".as_ref(),
+        prefix.as_os_str(),
+    ]);
+    let installed = prefix.join("OFX/Plugins/MorphFX.ofx.bundle");
+    let cargo_bin = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo_bin)
+        .args([
+            "run",
+            "--quiet",
+            "--package",
+            "morphfx-harness",
+            "--bin",
+            "morphfx",
+            "--",
+        ])
+        .arg("--bundle")
+        .arg(&installed)
+        .arg("plugins")
+        .current_dir(root())
+        .output()
+        .expect("morphfx runs");
+    let listing = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success()
+        || !listing.contains("net.morphfx.Morph")
+        || !listing.contains("net.morphfx.Warp")
+        || !installed
+            .join("Contents/Resources/net.morphfx.Morph.png")
+            .is_file()
+    {
+        eprintln!(
+            "cmake install check failed: {} lists\n{listing}{}",
+            installed.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        exit(1);
+    }
+    println!(
+        "cmake install check: {} loads and lists both plugins",
+        installed.display()
+    );
 }
 
 fn unsafe_env(key: &str, value: &Path) {

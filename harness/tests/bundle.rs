@@ -1,0 +1,370 @@
+//! The built bundle loaded through its C ABI (never linked): plugin list,
+//! descriptors, params, and renders held against the core engine's output for
+//! the same inputs at render scale 1 and 0.5, every depth and component kind,
+//! shifted image bounds, negative row bytes, and concurrent tiles.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+use morphfx::features::{Feature, FeatureKind, Side};
+use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::image::{EdgeMode, Filter, Image, Sampler};
+use morphfx::morph::dissolve;
+use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp};
+use morphfx::warp::Warp;
+use morphfx_harness::host::{Bundle, Frame, FrameSource, OutputSpec};
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::param::*;
+
+fn bundle() -> &'static Bundle {
+    static B: OnceLock<Bundle> = OnceLock::new();
+    B.get_or_init(|| {
+        let path = std::env::var("MORPHFX_BUNDLE")
+            .map(PathBuf::from)
+            .unwrap_or_else(|_| {
+                Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
+            });
+        Bundle::load(&path).expect("the bundle loads (build it with `cargo xtask bundle`)")
+    })
+}
+
+struct Still(Arc<Frame>);
+
+impl FrameSource for Still {
+    fn frame(&self, _time: f64) -> Result<Arc<Frame>, String> {
+        Ok(self.0.clone())
+    }
+}
+
+const DEPTHS: [&str; 3] = ["OfxBitDepthByte", "OfxBitDepthShort", "OfxBitDepthFloat"];
+
+/// Line pair k (A start, A end, B start, B end) in canonical pixels.
+fn lines() -> Vec<[(f64, f64); 4]> {
+    vec![
+        [(12.0, 10.0), (50.0, 14.0), (16.0, 6.0), (55.0, 12.0)],
+        [(20.0, 40.0), (22.0, 22.0), (24.0, 42.0), (20.0, 20.0)],
+        [(44.0, 20.0), (60.0, 38.0), (40.0, 24.0), (58.0, 40.0)],
+    ]
+}
+
+fn features() -> Vec<Feature> {
+    let v = |(x, y): (f64, f64)| Vec2::new(x, y);
+    lines()
+        .into_iter()
+        .map(|[a0, a1, b0, b1]| Feature {
+            name: None,
+            kind: FeatureKind::Line,
+            a: vec![v(a0), v(a1)],
+            b: vec![v(b0), v(b1)],
+        })
+        .collect()
+}
+
+/// A plate with smooth detail (values in [0, 1] so 8/16-bit hold them).
+fn plate(bounds: RectI, channels: usize, seed: f32) -> Image {
+    Image::from_fn(bounds, channels, |i, j, c| {
+        0.5 + 0.45 * ((i as f32 * 0.21 + seed) * (c as f32 + 1.0) + j as f32 * 0.13).sin()
+    })
+}
+
+struct Case {
+    depth: &'static str,
+    channels: usize,
+    scale: f64,
+    bounds: RectI,
+    top_down: bool,
+    tiles: usize,
+}
+
+impl Default for Case {
+    fn default() -> Self {
+        Case {
+            depth: "OfxBitDepthFloat",
+            channels: 4,
+            scale: 1.0,
+            bounds: RectI::new(0, 0, 64, 48),
+            top_down: false,
+            tiles: 1,
+        }
+    }
+}
+
+const T: f64 = 0.4;
+
+/// Renders the Morph node through the C ABI: (output, source frames as the plugin saw them).
+fn render_morph(case: &Case) -> (Image, Image, Image) {
+    let b = bundle();
+    let inst = b
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let fa = Arc::new(Frame::from_image(
+        &plate(case.bounds, case.channels, 0.0),
+        case.depth,
+        case.top_down,
+    ));
+    let fb = Arc::new(Frame::from_image(
+        &plate(case.bounds, case.channels, 1.3),
+        case.depth,
+        case.top_down,
+    ));
+    inst.connect("SourceA", Arc::new(Still(fa.clone())))
+        .unwrap();
+    inst.connect("SourceB", Arc::new(Still(fb.clone())))
+        .unwrap();
+    inst.set_project(case.bounds.width() as f64, case.bounds.height() as f64);
+    inst.set_double("progress", &[T], None).unwrap();
+    inst.set_choice("evaluation", "exact").unwrap();
+    let ls = lines();
+    inst.set_int("line_count", ls.len() as i32).unwrap();
+    for (k, [a0, a1, b0, b1]) in ls.into_iter().enumerate() {
+        let k = k + 1;
+        for (id, (x, y)) in [
+            ("a_start", a0),
+            ("a_end", a1),
+            ("b_start", b0),
+            ("b_end", b1),
+        ] {
+            inst.set_double(&format!("line{k}_{id}"), &[x, y], None)
+                .unwrap();
+        }
+    }
+    let spec = OutputSpec {
+        depth: case.depth,
+        channels: case.channels,
+        top_down: case.top_down,
+        render_scale: (case.scale, case.scale),
+        tiles: case.tiles,
+    };
+    inst.begin_sequence(1.0, 1.0).unwrap();
+    let out = inst.render(1.0, spec).unwrap();
+    inst.end_sequence(1.0, 1.0).unwrap();
+    let s = (case.scale, case.scale);
+    (
+        out.to_image(),
+        fa.scaled(s).to_image(),
+        fb.scaled(s).to_image(),
+    )
+}
+
+/// The core engine on the same (already scaled, already quantised) sources.
+fn expected(case: &Case, a: &Image, b: &Image) -> Image {
+    let settings = FieldSettings {
+        evaluation: Evaluation::Exact,
+        ..FieldSettings::default()
+    };
+    let f = features();
+    let scale = PixelScale::new(case.scale, case.scale, 1.0);
+    let full = a.bounds;
+    let ma = FieldWarp::toward(&f, Side::A, T, &settings).map_window(full, scale);
+    let mb = FieldWarp::toward(&f, Side::B, T, &settings).map_window(full, scale);
+    let sa = Sampler::new(a.view(), scale, Filter::Bilinear, EdgeMode::Clamp, true);
+    let sb = Sampler::new(b.view(), scale, Filter::Bilinear, EdgeMode::Clamp, true);
+    let mut out = Image::new(full, case.channels);
+    dissolve(&sa, &ma, &sb, &mb, T, out.view_mut().rows());
+    out
+}
+
+fn worst_difference(got: &Image, want: &Image) -> f32 {
+    assert_eq!(got.bounds, want.bounds, "output bounds");
+    assert_eq!(got.channels, want.channels);
+    got.data
+        .iter()
+        .zip(&want.data)
+        .map(|(g, w)| (g - w).abs())
+        .fold(0.0, f32::max)
+}
+
+/// One quantisation step of the depth, plus float noise.
+fn tolerance(depth: &str) -> f32 {
+    match depth {
+        "OfxBitDepthByte" => 1.0 / 255.0 + 1e-5,
+        "OfxBitDepthShort" => 1.0 / 65535.0 + 1e-5,
+        _ => 1e-5,
+    }
+}
+
+fn check(case: Case) {
+    let (got, a, b) = render_morph(&case);
+    let want = expected(&case, &a, &b);
+    let worst = worst_difference(&got, &want);
+    assert!(
+        worst <= tolerance(case.depth),
+        "{} ×{} channels, scale {}, bounds {:?}, top-down {}: off by {worst}",
+        case.depth,
+        case.channels,
+        case.scale,
+        case.bounds,
+        case.top_down
+    );
+    // Not a blank or pass-through image: the warp moved things.
+    let moved = worst_difference(&got, &a);
+    assert!(moved > 0.01, "output equals source A");
+}
+
+#[test]
+fn plugins_are_listed_with_ids_and_versions() {
+    let ids: Vec<_> = bundle()
+        .plugins
+        .iter()
+        .map(|p| (p.id.as_str(), p.version))
+        .collect();
+    assert_eq!(
+        ids,
+        vec![("net.morphfx.Morph", (1, 0)), ("net.morphfx.Warp", (1, 0))]
+    );
+}
+
+#[test]
+fn every_context_describes_and_instantiates() {
+    for (id, contexts) in [
+        (
+            "net.morphfx.Morph",
+            &[
+                "OfxImageEffectContextGeneral",
+                "OfxImageEffectContextTransition",
+            ][..],
+        ),
+        (
+            "net.morphfx.Warp",
+            &[
+                "OfxImageEffectContextGeneral",
+                "OfxImageEffectContextFilter",
+            ][..],
+        ),
+    ] {
+        for context in contexts {
+            let inst = bundle().instance(id, context);
+            assert!(inst.is_ok(), "{id} in {context}: {:?}", inst.err());
+        }
+    }
+}
+
+#[test]
+fn every_param_is_declared_with_label_hint_and_script_name() {
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let names = inst.param_names();
+    let mut expected: Vec<String> = [
+        "method",
+        "progress",
+        "use_scene_progress",
+        "settings_from_scene",
+        "field_a",
+        "field_b",
+        "field_p",
+        "line_interpolation",
+        "evaluation",
+        "tolerance",
+        "line_count",
+        "scene_file",
+        "scene_text",
+        "frame_offset_a",
+        "frame_offset_b",
+        "filter",
+        "edge",
+        "view",
+    ]
+    .map(String::from)
+    .to_vec();
+    for k in 1..=16 {
+        for s in ["enable", "a_start", "a_end", "b_start", "b_end"] {
+            expected.push(format!("line{k}_{s}"));
+        }
+    }
+    for id in &expected {
+        let props = inst
+            .param_props(id)
+            .unwrap_or_else(|| panic!("param {id} is missing"));
+        let label = props.str(kOfxPropLabel).unwrap_or_default();
+        let hint = props.str(kOfxParamPropHint).unwrap_or_default();
+        let script = props.str(kOfxParamPropScriptName).unwrap_or_default();
+        assert!(!label.is_empty(), "{id} has no label");
+        assert!(!hint.is_empty(), "{id} has no hint");
+        assert_eq!(script, *id, "{id}'s script name");
+    }
+    // Line positions are XY-absolute Double2D, animatable.
+    let p = inst.param_props("line1_a_start").unwrap();
+    let kind = names
+        .iter()
+        .find(|(n, _)| n == "line1_a_start")
+        .unwrap()
+        .1
+        .clone();
+    assert_eq!(kind, "OfxParamTypeDouble2D");
+    assert_eq!(
+        p.str(kOfxParamPropDoubleType).as_deref(),
+        Some("OfxParamDoubleTypeXYAbsolute")
+    );
+    assert_eq!(p.ints(kOfxParamPropAnimates), vec![1]);
+    // The method choice lists all seven methods.
+    let options = inst
+        .param_props("method")
+        .unwrap()
+        .strs(kOfxParamPropChoiceOption);
+    assert_eq!(options.len(), 7, "{options:?}");
+}
+
+#[test]
+fn renders_match_the_core_at_every_depth_and_component_kind() {
+    for depth in DEPTHS {
+        for channels in [4, 3, 1] {
+            check(Case {
+                depth,
+                channels,
+                ..Case::default()
+            });
+        }
+    }
+}
+
+#[test]
+fn renders_match_the_core_at_half_render_scale() {
+    for depth in DEPTHS {
+        check(Case {
+            depth,
+            scale: 0.5,
+            ..Case::default()
+        });
+    }
+}
+
+#[test]
+fn shifted_bounds_and_negative_row_bytes_match_the_core() {
+    let shifted = RectI::new(10, 7, 74, 55);
+    for depth in DEPTHS {
+        check(Case {
+            depth,
+            bounds: shifted,
+            top_down: true,
+            ..Case::default()
+        });
+        check(Case {
+            depth,
+            bounds: shifted,
+            scale: 0.5,
+            ..Case::default()
+        });
+    }
+}
+
+#[test]
+fn eight_concurrent_tiles_equal_the_serial_render() {
+    for depth in DEPTHS {
+        let serial = render_morph(&Case {
+            depth,
+            ..Case::default()
+        })
+        .0;
+        let tiled = render_morph(&Case {
+            depth,
+            tiles: 8,
+            ..Case::default()
+        })
+        .0;
+        assert_eq!(
+            serial, tiled,
+            "{depth}: tiles differ from the serial render"
+        );
+    }
+}
