@@ -49,6 +49,10 @@ pub struct Effect {
     pub messages: Mutex<Vec<Message>>,
     /// (render scale x, y) of the render in progress.
     pub render_scale: Mutex<(f64, f64)>,
+    /// The time line as this effect sees it: (current, first, last).
+    pub timeline: Mutex<(f64, f64, f64)>,
+    /// Progress the plugin last reported (progress suite), if a task is open.
+    pub progress: Mutex<Option<(String, f64)>>,
 }
 
 static LIVE_EFFECTS: Mutex<Option<HashSet<usize>>> = Mutex::new(None);
@@ -61,6 +65,8 @@ impl Effect {
             clips: Mutex::new(Vec::new()),
             messages: Mutex::new(Vec::new()),
             render_scale: Mutex::new((1.0, 1.0)),
+            timeline: Mutex::new((0.0, 0.0, 0.0)),
+            progress: Mutex::new(None),
         });
         LIVE_EFFECTS
             .lock()
@@ -124,7 +130,7 @@ impl Drop for Effect {
     }
 }
 
-fn live_effect<'a>(h: *const c_void) -> Option<&'a Effect> {
+pub(super) fn live_effect<'a>(h: *const c_void) -> Option<&'a Effect> {
     let live = LIVE_EFFECTS.lock().unwrap_or_else(|e| e.into_inner());
     if live.as_ref().is_some_and(|s| s.contains(&(h as usize))) {
         // SAFETY: registered effects are live boxes (removed on drop).

@@ -6,6 +6,7 @@ pub mod effect;
 pub mod frame;
 pub mod params;
 pub mod props;
+pub mod services;
 
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
@@ -15,8 +16,12 @@ use morphfx::geom::RectI;
 use openfx::sys::generic::core::*;
 use openfx::sys::generic::property::*;
 use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::memory::kOfxMemorySuite;
 use openfx::sys::image_effect_v1::message::*;
+use openfx::sys::image_effect_v1::multi_thread::kOfxMultiThreadSuite;
 use openfx::sys::image_effect_v1::param::*;
+use openfx::sys::image_effect_v1::progress::kOfxProgressSuite;
+use openfx::sys::image_effect_v1::time_line::kOfxTimeLineSuite;
 
 pub use effect::{Effect, FrameSource, Message};
 pub use frame::Frame;
@@ -77,8 +82,19 @@ unsafe extern "C" fn fetch_suite(
         (n, 1) if n == kOfxImageEffectSuite => &effect::SUITE as *const _ as *const c_void,
         (n, 1) if n == kOfxParameterSuite => &params::SUITE as *const _ as *const c_void,
         (n, 1) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE as *const _ as *const c_void,
-        // Anything else (memory, multi-thread, interact, ...) this host does not
-        // provide: a null answer is how OFX says so.
+        (n, 1) if n == kOfxMemorySuite => &services::MEMORY_SUITE as *const _ as *const c_void,
+        (n, 1) if n == kOfxMultiThreadSuite => {
+            &services::MULTI_THREAD_SUITE as *const _ as *const c_void
+        }
+        (n, 1) if n == kOfxProgressSuite => {
+            &services::PROGRESS_SUITE_V1 as *const _ as *const c_void
+        }
+        (n, 2) if n == kOfxProgressSuite => {
+            &services::PROGRESS_SUITE_V2 as *const _ as *const c_void
+        }
+        (n, 1) if n == kOfxTimeLineSuite => &services::TIME_LINE_SUITE as *const _ as *const c_void,
+        // Anything else (interact, OpenGL, ...) this host does not provide: a
+        // null answer is how OFX says so.
         _ => std::ptr::null(),
     }
 }
@@ -507,6 +523,11 @@ impl Instance<'_> {
     }
 
     pub fn begin_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
+        *self
+            .effect
+            .timeline
+            .lock()
+            .unwrap_or_else(|e| e.into_inner()) = (first, first, last);
         let a = Self::sequence_args(first, last);
         self.act(kOfxImageEffectActionBeginSequenceRender, Some(&a), None)
             .map(|_| ())
@@ -544,6 +565,11 @@ impl Instance<'_> {
     /// Renders the frame at `time` into a new buffer laid out as `spec`.
     pub fn render(&self, time: f64, spec: OutputSpec) -> Result<Arc<Frame>, HostError> {
         self.effect.take_messages();
+        self.effect
+            .timeline
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .0 = time;
         *self
             .effect
             .render_scale
