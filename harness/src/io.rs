@@ -34,6 +34,54 @@ pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
     }
 }
 
+/// The pixel bounds and display size of an image file, from its header only
+/// (for checking a whole sequence before rendering without reading it twice).
+pub fn probe(path: &Path) -> std::result::Result<(RectI, (usize, usize)), HostError> {
+    if !path.exists() {
+        return Err(HostError::bad(format!("{}: no such file", path.display())));
+    }
+    let is_exr = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr {
+        let (w, h) = ::image::image_dimensions(path)
+            .map_err(|e| HostError::bad(format!("{}: cannot read image: {e}", path.display())))?;
+        let (w, h) = (w as usize, h as usize);
+        return Ok((RectI::from_size(w, h), (w, h)));
+    }
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| HostError::bad(format!("{}: cannot read EXR: {e}", path.display())))?;
+    let header = meta
+        .headers
+        .first()
+        .ok_or_else(|| HostError::bad(format!("{}: EXR has no layers", path.display())))?;
+    let display = header.shared_attributes.display_window;
+    let pos = header.own_attributes.layer_position;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    Ok((
+        data_bounds(display, pos, (w, h)),
+        (display.size.width(), display.size.height()),
+    ))
+}
+
+/// An EXR data window in canonical pixels: EXR y grows downwards, canonical y
+/// upwards from the display window's bottom.
+fn data_bounds(
+    display: exr::meta::attribute::IntegerBounds,
+    pos: exr::math::Vec2<i32>,
+    (w, h): (usize, usize),
+) -> RectI {
+    let (dx, dy_top) = (display.position.x(), display.position.y());
+    let dh = display.size.height() as i32;
+    RectI::new(
+        pos.x() - dx,
+        dy_top + dh - (pos.y() + h as i32),
+        pos.x() - dx + w as i32,
+        dy_top + dh - pos.y(),
+    )
+}
+
 fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
     let img = exr::prelude::read()
         .no_deep_data()
@@ -69,15 +117,7 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
         _ if list.len() == 1 => vec![Some(0), Some(0), Some(0), None],
         _ => (0..4).map(|k| (k < list.len()).then_some(k)).collect(),
     };
-    let (dx, dy_top) = (display.position.x(), display.position.y());
-    let dh = display.size.height() as i32;
-    // EXR y grows downwards; canonical y grows upwards from the display window's bottom.
-    let bounds = RectI::new(
-        pos.x() - dx,
-        dy_top + dh - (pos.y() + h as i32),
-        pos.x() - dx + w as i32,
-        dy_top + dh - pos.y(),
-    );
+    let bounds = data_bounds(display, pos, (w, h));
     let mut image = Image::new(bounds, 4);
     for (c, pick) in picks.iter().enumerate() {
         match pick {
@@ -196,9 +236,12 @@ fn write_exr(
     let b = img.bounds;
     let dh = plate.size.1 as i32;
     let pixel = |pos: Vec2<usize>| rgba_at(plate, pos.x(), pos.y());
+    // Scan lines, as compositing packages write and read fastest, ZIP in
+    // 16-line blocks (lossless, the common default).
     let encoding = Encoding {
         compression: Compression::ZIP16,
-        ..Encoding::default()
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
     };
     let err = |e: exr::error::Error| {
         HostError::failed(format!("{}: cannot write EXR: {e}", path.display()))

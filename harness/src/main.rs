@@ -3,6 +3,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use morphfx::geom::RectI;
@@ -89,6 +90,18 @@ enum Command {
     },
     /// List the plugins in the bundle.
     Plugins,
+    /// Time a whole sequence morph on generated plates (EXR IO included) and
+    /// say where the time went.
+    Bench {
+        #[arg(short = 'o', long = "output", default_value = "morphfx-bench")]
+        output: PathBuf,
+        #[arg(long, default_value_t = 48)]
+        frames: usize,
+        #[arg(long, default_value_t = 1920)]
+        width: usize,
+        #[arg(long, default_value_t = 1080)]
+        height: usize,
+    },
 }
 
 fn main() {
@@ -168,6 +181,12 @@ fn run(cli: Cli) -> Result<(), HostError> {
             job.run(&bundle_path)
         }
         Command::Demo { output } => demo(&bundle_path, &output),
+        Command::Bench {
+            output,
+            frames,
+            width,
+            height,
+        } => bench(&bundle_path, &output, frames, (width, height)),
     }
 }
 
@@ -203,6 +222,8 @@ type CachedPlate = (i64, Arc<Frame>, (usize, usize));
 struct Plates {
     pattern: String,
     cache: Mutex<Vec<CachedPlate>>,
+    /// Time spent reading files, for the end-of-run summary.
+    read_time: Mutex<Duration>,
 }
 
 impl Plates {
@@ -210,6 +231,7 @@ impl Plates {
         Arc::new(Plates {
             pattern: pattern.to_owned(),
             cache: Mutex::new(Vec::new()),
+            read_time: Mutex::new(Duration::ZERO),
         })
     }
     fn plate(&self, frame: i64) -> Result<(Arc<Frame>, (usize, usize)), HostError> {
@@ -219,7 +241,9 @@ impl Plates {
             return Ok((f.clone(), *size));
         }
         let path = frame_path(&self.pattern, frame);
+        let started = Instant::now();
         let plate = io::read(&path)?;
+        *self.read_time.lock().unwrap_or_else(|e| e.into_inner()) += started.elapsed();
         let f = Arc::new(Frame::from_image(&plate.image, "OfxBitDepthFloat", false));
         cache.retain(|(k, _, _)| (k - frame).abs() <= 2);
         cache.push((frame, f.clone(), plate.size));
@@ -282,11 +306,12 @@ impl Job {
         for &f in &frames {
             let mut first: Option<(RectI, (usize, usize), String)> = None;
             for (_, p) in &plates {
-                let (frame, s) = p.plate(f)?;
-                let name = frame_path(&p.pattern, f).display().to_string();
+                let path = frame_path(&p.pattern, if is_sequence(&p.pattern) { f } else { 0 });
+                let (bounds, s) = io::probe(&path)?;
+                let name = path.display().to_string();
                 match &first {
-                    None => first = Some((frame.bounds, s, name)),
-                    Some((b, s0, n0)) if *s0 != s || *b != frame.bounds => {
+                    None => first = Some((bounds, s, name)),
+                    Some((b, s0, n0)) if *s0 != s || *b != bounds => {
                         return Err(HostError::bad(format!(
                             "size mismatch: {name} is {}x{} but {n0} is {}x{}",
                             s.0, s.1, s0.0, s0.1
@@ -323,10 +348,12 @@ impl Job {
             frames[0] as f64,
             *frames.last().unwrap_or(&frames[0]) as f64,
         )?;
+        let (run_start, mut writing) = (Instant::now(), Duration::ZERO);
         for (n, &f) in frames.iter().enumerate() {
             for (view, pattern) in &outputs {
                 inst.set_choice("view", view)?;
                 let out = inst.render(f as f64, OutputSpec::default())?;
+                let started = Instant::now();
                 io::write(
                     &frame_path(pattern, f),
                     &Plate {
@@ -335,6 +362,7 @@ impl Job {
                     },
                     precision,
                 )?;
+                writing += started.elapsed();
             }
             progress.tick(n + 1, f);
         }
@@ -342,7 +370,21 @@ impl Job {
             frames[0] as f64,
             *frames.last().unwrap_or(&frames[0]) as f64,
         )?;
-        progress.done();
+        // Plates are read when the plugin asks for them (inside actions), so
+        // rendering is what remains of the loop.
+        let reading: Duration = plates
+            .iter()
+            .map(|(_, p)| *p.read_time.lock().unwrap_or_else(|e| e.into_inner()))
+            .sum();
+        progress.done(&format!(
+            "read {:.2} s, render {:.2} s, write {:.2} s",
+            reading.as_secs_f64(),
+            run_start
+                .elapsed()
+                .saturating_sub(reading + writing)
+                .as_secs_f64(),
+            writing.as_secs_f64()
+        ));
         Ok(())
     }
 }
@@ -390,11 +432,104 @@ impl Progress {
             None => {}
         }
     }
-    fn done(&self) {
+    /// Finishes the bar and says where the time went.
+    fn done(&self, breakdown: &str) {
         if let Some(b) = &self.bar {
             b.finish();
         }
+        let secs = self.start.elapsed().as_secs_f64();
+        eprintln!(
+            "{} frame(s) in {secs:.2} s ({:.2} fps): {breakdown}",
+            self.total,
+            self.total as f64 / secs.max(1e-9)
+        );
     }
+}
+
+/// Plate sequences A and B of `frames` frames (a drifting pattern each), a
+/// scene of 20 keyframed lines, then the morph of the whole range timed as a
+/// user runs it: read plates, render through the bundle, write float EXR.
+fn bench(
+    bundle_path: &Path,
+    dir: &Path,
+    frames: usize,
+    (w, h): (usize, usize),
+) -> Result<(), HostError> {
+    if frames == 0 || w < 16 || h < 16 {
+        return Err(HostError::bad("bench needs at least 1 frame of 16x16"));
+    }
+    let plates = dir.join("plates");
+    eprintln!(
+        "writing {frames} frames of {w}x{h} plates A and B to {}",
+        plates.display()
+    );
+    for f in 1..=frames as i64 {
+        for (name, seed) in [("a", 0.0f32), ("b", 2.1)] {
+            let drift = f as f32 * 1.5;
+            let image = Image::from_fn(RectI::from_size(w, h), 4, |i, j, c| {
+                let (x, y) = (i as f32 + drift, j as f32);
+                if c == 3 {
+                    1.0
+                } else {
+                    0.5 + 0.4 * ((x * 0.013 + seed) * (c as f32 + 1.0)).sin() * (y * 0.021).cos()
+                }
+            });
+            io::write(
+                &frame_path(
+                    &plates.join(format!("{name}.####.exr")).to_string_lossy(),
+                    f,
+                ),
+                &Plate {
+                    image,
+                    size: (w, h),
+                },
+                ExrPrecision::Float,
+            )?;
+        }
+    }
+    // 20 lines over the frame, moving a little between the first and last key.
+    let (fw, fh) = (w as f64, h as f64);
+    let line = |k: usize, shift: f64| {
+        let (x, y) = (
+            fw * (0.1 + 0.8 * ((k * 7) % 20) as f64 / 20.0),
+            fh * (0.1 + 0.8 * ((k * 13) % 20) as f64 / 20.0),
+        );
+        let len = fw * 0.06;
+        serde_json::json!({
+            "type": "line",
+            "a": [[x, y], [x + len, y + 0.3 * len]],
+            "b": [[x + shift, y - shift], [x + len + shift, y + 0.3 * len + 0.5 * shift]]
+        })
+    };
+    let key = |frame: usize, shift: f64| serde_json::json!({ "frame": frame, "features": (0..20).map(|k| line(k, shift)).collect::<Vec<_>>() });
+    let scene = serde_json::json!({
+        "format": "morphfx-scene", "version": 1, "method": "field",
+        "keyframes": [key(1, fw * 0.01), key(frames, fw * 0.02)],
+        "progress": [[1, 0.0], [frames, 1.0]]
+    });
+    let scene_path = dir.join("bench.morph.json");
+    std::fs::write(&scene_path, scene.to_string())
+        .map_err(|e| HostError::failed(format!("{}: {e}", scene_path.display())))?;
+    let s = |p: PathBuf| p.to_string_lossy().into_owned();
+    eprintln!("rendering the morph of frames 1-{frames}");
+    Job {
+        plugin: MORPH_ID,
+        context: "OfxImageEffectContextGeneral",
+        sources: vec![
+            ("SourceA".into(), s(plates.join("a.####.exr"))),
+            ("SourceB".into(), s(plates.join("b.####.exr"))),
+        ],
+        view: "morph".into(),
+        extra: vec![],
+        common: Common {
+            scene: scene_path,
+            t: None,
+            frames: Some(format!("1-{frames}")),
+            output: s(dir.join("morph.####.exr")),
+            half: false,
+        },
+    }
+    .run(bundle_path)
 }
 
 /// Two procedural plates with recognisable features: a warm disc face on A,

@@ -1,0 +1,266 @@
+//! Sequences through the `morphfx` binary and the bundle: keyframed features
+//! at in-between frames, sequence renders against single-frame renders,
+//! EXR precision round trips, and OpenImageIO reading our outputs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use morphfx::geom::RectI;
+use morphfx::image::Image;
+use morphfx_harness::io::{self, ExrPrecision, Plate};
+
+fn bundle() -> PathBuf {
+    std::env::var("MORPHFX_BUNDLE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
+        })
+}
+
+fn morphfx(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
+        .arg("--bundle")
+        .arg(bundle())
+        .args(args)
+        .output()
+        .expect("morphfx runs");
+    assert!(
+        out.status.success(),
+        "morphfx {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("morphfx-seq-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write_plate(path: &Path, w: usize, h: usize, seed: f32, precision: ExrPrecision) {
+    let img = Image::from_fn(RectI::from_size(w, h), 4, |i, j, c| {
+        // Multiples of 1/256 in [0, 4): exact in half as well as float.
+        let v = ((i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin() + 1.0) * 2.0;
+        (v * 256.0).floor() / 256.0
+    });
+    let plate = Plate {
+        image: img,
+        size: (w, h),
+    };
+    io::write(path, &plate, precision).unwrap();
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// One line, same on A at both keys; on B it sits (7, −5) away at frame 1001
+/// and (−3, 5) away at 1011. A single line pair of equal length and direction
+/// is a pure translation, so at t = 1 the map at frame 1006 must translate by
+/// the halfway offset (2, 0).
+const KEYED: &str = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
+  "field": {"evaluation": "exact"},
+  "keyframes": [
+    {"frame": 1001, "features": [{"type": "line", "a": [[10, 10], [40, 10]], "b": [[17, 5], [47, 5]]}]},
+    {"frame": 1011, "features": [{"type": "line", "a": [[10, 10], [40, 10]], "b": [[7, 15], [37, 15]]}]}
+  ]}"#;
+
+#[test]
+fn keyframed_features_interpolate_at_an_in_between_frame() {
+    let d = tmp("keys");
+    write_plate(&d.join("a.1006.exr"), 64, 48, 0.0, ExrPrecision::Float);
+    std::fs::write(d.join("s.morph.json"), KEYED).unwrap();
+    morphfx(&[
+        "warp",
+        "--scene",
+        s(&d.join("s.morph.json")),
+        "--input",
+        s(&d.join("a.####.exr")),
+        "--frames",
+        "1006",
+        "--t",
+        "1",
+        "--view",
+        "stmap",
+        "-o",
+        s(&d.join("st.####.exr")),
+    ]);
+    let st = io::read(&d.join("st.1006.exr")).unwrap().image;
+    for j in 0..48 {
+        for i in 0..64 {
+            let px = st.pixel(i, j);
+            let want = ((i as f32 + 0.5 - 2.0) / 64.0, (j as f32 + 0.5) / 48.0);
+            assert!(
+                (px[0] - want.0).abs() < 1e-4 && (px[1] - want.1).abs() < 1e-4,
+                "({i},{j}): {px:?}, want {want:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_sequence_render_equals_single_frame_renders_whatever_the_chunking() {
+    let d = tmp("chunks");
+    for f in 1001..=1004 {
+        write_plate(
+            &d.join(format!("a.{f}.exr")),
+            48,
+            32,
+            f as f32 * 0.3,
+            ExrPrecision::Float,
+        );
+        write_plate(
+            &d.join(format!("b.{f}.exr")),
+            48,
+            32,
+            f as f32 * 0.7,
+            ExrPrecision::Float,
+        );
+    }
+    let scene = KEYED.replace(
+        r#""keyframes""#,
+        r#""progress": [[1001, 0.0], [1004, 1.0]], "keyframes""#,
+    );
+    std::fs::write(d.join("s.morph.json"), scene).unwrap();
+    let render = |frames: &str, out: &str| {
+        morphfx(&[
+            "morph",
+            "--scene",
+            s(&d.join("s.morph.json")),
+            "--a",
+            s(&d.join("a.####.exr")),
+            "--b",
+            s(&d.join("b.####.exr")),
+            "--frames",
+            frames,
+            "-o",
+            s(&d.join(out)),
+        ])
+    };
+    render("1001-1004", "whole.####.exr");
+    render("1001-1002", "chunk.####.exr");
+    render("1003-1004", "chunk.####.exr");
+    for f in 1001..=1004 {
+        render(&f.to_string(), "single.####.exr");
+    }
+    for f in 1001..=1004 {
+        let whole = io::read(&d.join(format!("whole.{f}.exr"))).unwrap().image;
+        for other in ["chunk", "single"] {
+            let o = io::read(&d.join(format!("{other}.{f}.exr"))).unwrap().image;
+            assert_eq!(
+                whole, o,
+                "frame {f}: {other} differs from the sequence render"
+            );
+        }
+    }
+    // The in-between frames really are in between (not a copy of A or B).
+    let mid = io::read(&d.join("whole.1002.exr")).unwrap().image;
+    let a = io::read(&d.join("a.1002.exr")).unwrap().image;
+    assert_ne!(mid, a);
+}
+
+#[test]
+fn float_and_half_exr_round_trip_bit_exactly() {
+    let d = tmp("exr");
+    for (precision, flag) in [
+        (ExrPrecision::Float, None),
+        (ExrPrecision::Half, Some("--half")),
+    ] {
+        let src = d.join("src.exr");
+        write_plate(&src, 40, 24, 0.5, precision);
+        let read = io::read(&src).unwrap();
+        // Writing what we read gives the same pixels again.
+        let again = d.join("again.exr");
+        io::write(&again, &read, precision).unwrap();
+        assert_eq!(io::read(&again).unwrap().image, read.image, "{precision:?}");
+        // Through the plugin at t = 0 with an identity warp: pixels unchanged.
+        std::fs::write(
+            d.join("s.morph.json"),
+            r#"{"format": "morphfx-scene", "version": 1,
+                "features": [{"type": "line", "a": [[5, 5], [30, 5]], "b": [[5, 5], [30, 5]]}]}"#,
+        )
+        .unwrap();
+        let (out, scene) = (d.join("out.exr"), d.join("s.morph.json"));
+        let mut args = vec![
+            "morph",
+            "--scene",
+            s(&scene),
+            "--a",
+            s(&src),
+            "--b",
+            s(&src),
+            "--t",
+            "0",
+            "-o",
+            s(&out),
+        ];
+        args.extend(flag);
+        morphfx(&args);
+        assert_eq!(
+            io::read(&out).unwrap().image,
+            read.image,
+            "{precision:?} through the plugin"
+        );
+    }
+}
+
+/// OpenImageIO, an independent EXR reader, sees the pixels we think we wrote.
+#[test]
+fn openimageio_reads_our_outputs_as_we_do() {
+    if Command::new("oiiotool").arg("--version").output().is_err() {
+        eprintln!("skipped: oiiotool is not installed (apt-get install openimageio-tools)");
+        return;
+    }
+    let d = tmp("oiio");
+    for (precision, name) in [
+        (ExrPrecision::Float, "f.exr"),
+        (ExrPrecision::Half, "h.exr"),
+    ] {
+        let p = d.join(name);
+        write_plate(&p, 16, 8, 0.2, precision);
+        let ours = io::read(&p).unwrap().image;
+        let dump = Command::new("oiiotool")
+            .arg("--dumpdata")
+            .arg(&p)
+            .output()
+            .expect("oiiotool runs");
+        assert!(
+            dump.status.success(),
+            "{}",
+            String::from_utf8_lossy(&dump.stderr)
+        );
+        let text = String::from_utf8_lossy(&dump.stdout);
+        let mut seen = 0;
+        for line in text.lines() {
+            // "    Pixel (x, y): r g b a"
+            let Some(rest) = line.trim().strip_prefix("Pixel (") else {
+                continue;
+            };
+            let (xy, values) = rest.split_once("):").unwrap();
+            let (x, y) = xy.split_once(',').unwrap();
+            let (x, y): (i32, i32) = (x.trim().parse().unwrap(), y.trim().parse().unwrap());
+            let values: Vec<f32> = values
+                .split_whitespace()
+                .map(|v| v.parse().unwrap())
+                .collect();
+            // OIIO counts rows from the top; ours from the bottom.
+            let j = 8 - 1 - y;
+            assert_eq!(values, ours.pixel(x, j), "{name} pixel ({x}, {y})");
+            seen += 1;
+        }
+        assert_eq!(seen, 16 * 8, "{name}: oiiotool listed every pixel");
+        // "file :   16 x    8, 4 channel, half openexr"
+        let header = text.lines().next().unwrap_or_default();
+        let words: Vec<&str> = header.split_whitespace().collect();
+        let kind = if precision == ExrPrecision::Half {
+            "half"
+        } else {
+            "float"
+        };
+        assert!(
+            header.contains("16 x    8, 4 channel") && words.contains(&kind),
+            "{name}: {header}"
+        );
+    }
+}
