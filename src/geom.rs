@@ -59,6 +59,18 @@ impl Vec2 {
     pub fn distance(self, o: Vec2) -> f64 {
         (self - o).length()
     }
+    /// Distance to the segment `p`–`q` (to `p` when it has no length).
+    #[inline]
+    pub fn distance_to_segment(self, p: Vec2, q: Vec2) -> f64 {
+        let d = q - p;
+        let len2 = d.length_squared();
+        let u = if len2 > 0.0 {
+            ((self - p).dot(d) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self.distance(p + d * u)
+    }
 }
 
 impl Add for Vec2 {

@@ -113,20 +113,9 @@ pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: RowsMut
         let c = scale.pixel_centre(i, j);
         let on_feature = segments
             .iter()
-            .any(|&(p, q)| distance_to_segment(c, p, q) <= 1.0 / scale.y.min(scale.x));
+            .any(|&(p, q)| c.distance_to_segment(p, q) <= 1.0 / scale.y.min(scale.x));
         if on_feature {
             *px = [1.0, 0.55, 0.1, 1.0];
         }
     });
-}
-
-fn distance_to_segment(x: Vec2, p: Vec2, q: Vec2) -> f64 {
-    let d = q - p;
-    let len2 = d.length_squared();
-    let u = if len2 > 0.0 {
-        ((x - p).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p + d * u).distance(x)
 }

@@ -34,8 +34,13 @@ struct Cli {
 #[derive(clap::Args, Clone)]
 struct Common {
     /// Scene file (*.morph.json).
-    #[arg(long)]
-    scene: PathBuf,
+    #[arg(long, required_unless_present = "line")]
+    scene: Option<PathBuf>,
+    /// A line pair in the node's slot N, as a host would key it:
+    /// `N=ax0,ay0,ax1,ay1,bx0,by0,bx1,by1` (constant) or `N@FRAME=...` (a key
+    /// at FRAME; keys of one slot interpolate like a host's). Repeatable.
+    #[arg(long = "line", value_name = "SPEC")]
+    line: Vec<String>,
     /// Progress t in [0, 1]; overrides the scene's progress keys.
     #[arg(long)]
     t: Option<f64>,
@@ -259,6 +264,53 @@ impl FrameSource for Plates {
     }
 }
 
+/// One `--line` value: slot, optional key frame, A start/end then B start/end.
+struct LineKey {
+    slot: usize,
+    frame: Option<f64>,
+    coords: [f64; 8],
+}
+
+impl LineKey {
+    const SLOTS: usize = 16;
+
+    fn parse(spec: &str) -> Result<LineKey, HostError> {
+        let bad = |why: &str| {
+            HostError::bad(format!(
+                "--line {spec}: {why} (expected N=ax0,ay0,ax1,ay1,bx0,by0,bx1,by1 or N@FRAME=...)"
+            ))
+        };
+        let (head, values) = spec.split_once('=').ok_or_else(|| bad("no '='"))?;
+        let (slot, frame) = match head.split_once('@') {
+            Some((n, f)) => (
+                n,
+                Some(f.trim().parse::<f64>().map_err(|_| bad("bad frame"))?),
+            ),
+            None => (head, None),
+        };
+        let slot: usize = slot.trim().parse().map_err(|_| bad("bad slot number"))?;
+        if !(1..=Self::SLOTS).contains(&slot) {
+            return Err(bad(&format!("slot must be 1 to {}", Self::SLOTS)));
+        }
+        let numbers: Vec<f64> = values
+            .split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad("bad number"))?;
+        let coords: [f64; 8] = numbers
+            .try_into()
+            .map_err(|_| bad("needs exactly 8 numbers"))?;
+        if coords.iter().any(|v| !v.is_finite()) || frame.is_some_and(|f| !f.is_finite()) {
+            return Err(bad("numbers must be finite"));
+        }
+        Ok(LineKey {
+            slot,
+            frame,
+            coords,
+        })
+    }
+}
+
 struct Job {
     plugin: &'static str,
     context: &'static str,
@@ -272,10 +324,22 @@ struct Job {
 impl Job {
     fn run(&self, bundle_path: &Path) -> Result<(), HostError> {
         let c = &self.common;
-        let scene_text = std::fs::read_to_string(&c.scene)
-            .map_err(|e| HostError::bad(format!("scene {}: {e}", c.scene.display())))?;
-        let scene = Scene::parse(&scene_text)
-            .map_err(|e| HostError::bad(format!("scene {}: {e}", c.scene.display())))?;
+        let scene = match &c.scene {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| HostError::bad(format!("scene {}: {e}", path.display())))?;
+                Some(
+                    Scene::parse(&text)
+                        .map_err(|e| HostError::bad(format!("scene {}: {e}", path.display())))?,
+                )
+            }
+            None => None,
+        };
+        let lines = c
+            .line
+            .iter()
+            .map(|spec| LineKey::parse(spec))
+            .collect::<Result<Vec<_>, _>>()?;
         if let Some(t) = c.t {
             if !(0.0..=1.0).contains(&t) {
                 return Err(HostError::bad(format!("--t {t}: must be in [0, 1]")));
@@ -289,10 +353,14 @@ impl Job {
                 ))
             }
             None => vec![scene
-                .keyframes
-                .first()
-                .map(|k| k.frame)
-                .or(scene.progress.first().map(|p| p.0))
+                .as_ref()
+                .and_then(|s| {
+                    s.keyframes
+                        .first()
+                        .map(|k| k.frame)
+                        .or(s.progress.first().map(|p| p.0))
+                })
+                .or(lines.iter().find_map(|l| l.frame))
                 .unwrap_or(0.0) as i64],
         };
         let plates: Vec<(String, Arc<Plates>)> = self
@@ -325,8 +393,19 @@ impl Job {
 
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;
-        let scene_path = std::fs::canonicalize(&c.scene).unwrap_or_else(|_| c.scene.clone());
-        inst.set_string("scene_file", &scene_path.to_string_lossy())?;
+        if let Some(path) = &c.scene {
+            let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.clone());
+            inst.set_string("scene_file", &path.to_string_lossy())?;
+        }
+        if let Some(count) = lines.iter().map(|l| l.slot).max() {
+            inst.set_int("line_count", count as i32)?;
+            for l in &lines {
+                for (k, id) in ["a_start", "a_end", "b_start", "b_end"].iter().enumerate() {
+                    let xy = [l.coords[2 * k], l.coords[2 * k + 1]];
+                    inst.set_double(&format!("line{}_{id}", l.slot), &xy, l.frame)?;
+                }
+            }
+        }
         if let Some(t) = c.t {
             inst.set_double("progress", &[t], None)?;
             inst.set_int("use_scene_progress", 0)?;
@@ -522,7 +601,8 @@ fn bench(
         view: "morph".into(),
         extra: vec![],
         common: Common {
-            scene: scene_path,
+            scene: Some(scene_path),
+            line: Vec::new(),
             t: None,
             frames: Some(format!("1-{frames}")),
             output: s(dir.join("morph.####.exr")),
@@ -627,7 +707,8 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
             ("stmap-a".into(), s(dir.join("stmap_a.####.exr"))),
         ],
         common: Common {
-            scene: scene_path.clone(),
+            scene: Some(scene_path.clone()),
+            line: Vec::new(),
             t: None,
             frames: Some("1-12".into()),
             output: s(dir.join("morph.####.exr")),

@@ -3,8 +3,9 @@
 //! the same inputs at render scale 1 and 0.5, every depth and component kind,
 //! shifted image bounds, negative row bytes, and concurrent tiles.
 
-use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
+
+mod common;
 
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, RectI, Vec2};
@@ -19,12 +20,8 @@ use openfx::sys::image_effect_v1::param::*;
 fn bundle() -> &'static Bundle {
     static B: OnceLock<Bundle> = OnceLock::new();
     B.get_or_init(|| {
-        let path = std::env::var("MORPHFX_BUNDLE")
-            .map(PathBuf::from)
-            .unwrap_or_else(|_| {
-                Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
-            });
-        Bundle::load(&path).expect("the bundle loads (build it with `cargo xtask bundle`)")
+        Bundle::load(&common::bundle_path())
+            .expect("the bundle loads (build it with `cargo xtask bundle`)")
     })
 }
 

@@ -2,6 +2,8 @@
 //! EXR plates, checked against closed-form expectations.
 
 use std::path::{Path, PathBuf};
+
+mod common;
 use std::process::Command;
 
 use morphfx::geom::RectI;
@@ -9,11 +11,7 @@ use morphfx::image::Image;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 
 fn bundle() -> PathBuf {
-    std::env::var("MORPHFX_BUNDLE")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
-        })
+    common::bundle_path()
 }
 
 fn morphfx(args: &[&str]) -> (i32, String) {
@@ -30,10 +28,7 @@ fn morphfx(args: &[&str]) -> (i32, String) {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("morphfx-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch(name)
 }
 
 fn plate(dir: &Path, name: &str, w: usize, h: usize, seed: f32) -> String {

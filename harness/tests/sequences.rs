@@ -3,6 +3,8 @@
 //! EXR precision round trips, and OpenImageIO reading our outputs.
 
 use std::path::{Path, PathBuf};
+
+mod common;
 use std::process::Command;
 
 use morphfx::geom::RectI;
@@ -10,11 +12,7 @@ use morphfx::image::Image;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 
 fn bundle() -> PathBuf {
-    std::env::var("MORPHFX_BUNDLE")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
-        })
+    common::bundle_path()
 }
 
 fn morphfx(args: &[&str]) {
@@ -32,10 +30,7 @@ fn morphfx(args: &[&str]) {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("morphfx-seq-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch(name)
 }
 
 fn write_plate(path: &Path, w: usize, h: usize, seed: f32, precision: ExrPrecision) {
@@ -86,13 +81,22 @@ fn keyframed_features_interpolate_at_an_in_between_frame() {
         "-o",
         s(&d.join("st.####.exr")),
     ]);
-    let st = io::read(&d.join("st.1006.exr")).unwrap().image;
+    assert_translation(&d.join("st.1006.exr"), (2.0, 0.0), 1e-4);
+}
+
+/// The 64×48 ST map at `path` is the translation of every pixel centre by
+/// `-shift` (normalised), within `tol` of a unit square.
+fn assert_translation(path: &Path, shift: (f32, f32), tol: f32) {
+    let st = io::read(path).unwrap().image;
     for j in 0..48 {
         for i in 0..64 {
             let px = st.pixel(i, j);
-            let want = ((i as f32 + 0.5 - 2.0) / 64.0, (j as f32 + 0.5) / 48.0);
+            let want = (
+                (i as f32 + 0.5 - shift.0) / 64.0,
+                (j as f32 + 0.5 - shift.1) / 48.0,
+            );
             assert!(
-                (px[0] - want.0).abs() < 1e-4 && (px[1] - want.1).abs() < 1e-4,
+                (px[0] - want.0).abs() < tol && (px[1] - want.1).abs() < tol,
                 "({i},{j}): {px:?}, want {want:?}"
             );
         }
@@ -263,4 +267,44 @@ fn openimageio_reads_our_outputs_as_we_do() {
             "{name}: {header}"
         );
     }
+}
+
+/// The same in-between as the keyframed scene, but keyed in the node's line
+/// slot through the host's param keyframes (`--line N@FRAME=...`).
+#[test]
+fn host_keyed_line_slots_interpolate_at_an_in_between_frame() {
+    let d = tmp("slots");
+    write_plate(&d.join("a.1006.exr"), 64, 48, 0.0, ExrPrecision::Float);
+    morphfx(&[
+        "warp",
+        "--line",
+        "1@1001=10,10,40,10,17,5,47,5",
+        "--line",
+        "1@1011=10,10,40,10,7,15,37,15",
+        "--input",
+        s(&d.join("a.####.exr")),
+        "--frames",
+        "1006",
+        "--t",
+        "1",
+        "--view",
+        "stmap",
+        "-o",
+        s(&d.join("st.####.exr")),
+    ]);
+    // Adaptive evaluation (the node's default): within its 0.05 px tolerance.
+    assert_translation(&d.join("st.1006.exr"), (2.0, 0.0), 0.05 / 48.0);
+    // A malformed slot is bad input, named.
+    let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
+        .arg("--bundle")
+        .arg(bundle())
+        .args(["warp", "--line", "17=1,2,3,4,5,6,7,8", "--input"])
+        .arg(d.join("a.1006.exr"))
+        .arg("-o")
+        .arg(d.join("never.exr"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--line 17="));
+    assert!(!d.join("never.exr").exists());
 }

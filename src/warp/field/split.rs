@@ -277,20 +277,9 @@ fn segment_box_distance(p: Vec2, q: Vec2, lo: Vec2, hi: Vec2) -> f64 {
     };
     let corner_to_segment = corners
         .iter()
-        .map(|&c| point_segment_distance(c, p, q))
+        .map(|&c| c.distance_to_segment(p, q))
         .fold(f64::INFINITY, f64::min);
     to_box(p).min(to_box(q)).min(corner_to_segment)
-}
-
-fn point_segment_distance(x: Vec2, p: Vec2, q: Vec2) -> f64 {
-    let d = q - p;
-    let len2 = d.length_squared();
-    let u = if len2 > 0.0 {
-        ((x - p).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    x.distance(p + d * u)
 }
 
 fn segments_cross(p: Vec2, q: Vec2, a: Vec2, b: Vec2) -> bool {

@@ -118,16 +118,21 @@ fn multi_line_pixels_on_a_line_follow_that_line() {
     }
 }
 
-fn random_pairs(seed: u64, n: usize, size: f64) -> Vec<LinePair> {
-    let mut s = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    let mut r = move || {
+/// Deterministic uniform numbers in [0, 1) (a 64-bit LCG's high bits).
+fn uniform(mut s: u64) -> impl FnMut() -> f64 {
+    move || {
         s = s
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    }
+}
+
+fn random_pairs(seed: u64, n: usize, size: f64) -> Vec<LinePair> {
+    let mut r = uniform(
+        seed.wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407),
+    );
     (0..n)
         .map(|_| {
             let p = v(r() * size, r() * size);
@@ -213,13 +218,7 @@ fn adaptive_mode_stays_within_its_tolerance_on_random_line_sets() {
 /// Long lines spread over a wide frame, many of them: every block mixes
 /// near and far lines, the case the adaptive split exists for.
 fn spread_pairs(seed: u64, n: usize, w: f64, h: f64) -> Vec<LinePair> {
-    let mut s = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut r = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut r = uniform(seed.wrapping_add(0x9E37_79B9_7F4A_7C15));
     (0..n)
         .map(|_| {
             let p = v(r() * w, r() * h);

@@ -1,0 +1,22 @@
+//! Shared by the harness's integration tests: where the built bundle is, and
+//! a scratch folder per test.
+
+use std::path::{Path, PathBuf};
+
+/// The bundle `cargo xtask test` built (MORPHFX_BUNDLE), else the checkout's.
+pub fn bundle_path() -> PathBuf {
+    std::env::var("MORPHFX_BUNDLE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
+        })
+}
+
+/// An empty folder for one test of this process.
+#[allow(dead_code)] // not every test file needs one
+pub fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("morphfx-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
