@@ -229,6 +229,9 @@ struct Plates {
     cache: Mutex<Vec<CachedPlate>>,
     /// Time spent reading files, for the end-of-run summary.
     read_time: Mutex<Duration>,
+    /// The first read that failed: the plugin only learns "no image", so the
+    /// harness reports the file and why itself.
+    error: Mutex<Option<HostError>>,
 }
 
 impl Plates {
@@ -237,6 +240,7 @@ impl Plates {
             pattern: pattern.to_owned(),
             cache: Mutex::new(Vec::new()),
             read_time: Mutex::new(Duration::ZERO),
+            error: Mutex::new(None),
         })
     }
     fn plate(&self, frame: i64) -> Result<(Arc<Frame>, (usize, usize)), HostError> {
@@ -247,7 +251,12 @@ impl Plates {
         }
         let path = frame_path(&self.pattern, frame);
         let started = Instant::now();
-        let plate = io::read(&path)?;
+        let plate = io::read(&path).inspect_err(|e| {
+            self.error
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .get_or_insert_with(|| e.clone());
+        })?;
         *self.read_time.lock().unwrap_or_else(|e| e.into_inner()) += started.elapsed();
         let f = Arc::new(Frame::from_image(&plate.image, "OfxBitDepthFloat", false));
         cache.retain(|(k, _, _)| (k - frame).abs() <= 2);
@@ -427,11 +436,20 @@ impl Job {
             frames[0] as f64,
             *frames.last().unwrap_or(&frames[0]) as f64,
         )?;
+        // A plate that fails to decode surfaces as a failed action; name it.
+        let read_error = |e: HostError| {
+            plates
+                .iter()
+                .find_map(|(_, p)| p.error.lock().unwrap_or_else(|p| p.into_inner()).take())
+                .unwrap_or(e)
+        };
         let (run_start, mut writing) = (Instant::now(), Duration::ZERO);
         for (n, &f) in frames.iter().enumerate() {
             for (view, pattern) in &outputs {
                 inst.set_choice("view", view)?;
-                let out = inst.render(f as f64, OutputSpec::default())?;
+                let out = inst
+                    .render(f as f64, OutputSpec::default())
+                    .map_err(read_error)?;
                 let started = Instant::now();
                 io::write(
                     &frame_path(pattern, f),

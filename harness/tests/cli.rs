@@ -195,6 +195,38 @@ fn size_mismatch_and_missing_frames_exit_2() {
 }
 
 #[test]
+fn unreadable_and_truncated_plates_exit_2_naming_the_file() {
+    let d = tmp("unreadable");
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    std::fs::write(d.join("junk.exr"), b"not an image at all").unwrap();
+    // A valid header whose pixel data is cut short: only decoding finds out.
+    let whole = plate(&d, "whole.exr", 64, 48, 0.0);
+    let bytes = std::fs::read(&whole).unwrap();
+    std::fs::write(d.join("cut.exr"), &bytes[..bytes.len() * 2 / 3]).unwrap();
+    for name in ["junk.exr", "cut.exr"] {
+        let out = d.join(format!("o-{name}"));
+        let (code, err) = morphfx(&[
+            "warp",
+            "--scene",
+            d.join("s.morph.json").to_str().unwrap(),
+            "--input",
+            d.join(name).to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains(name), "{name}: {err}");
+        assert!(!out.exists(), "{name}: output written");
+        let leftovers: Vec<_> = std::fs::read_dir(&d)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+            .collect();
+        assert!(leftovers.is_empty(), "{name}: partial files left");
+    }
+}
+
+#[test]
 fn a_panic_inside_the_plugin_becomes_a_failure_status_not_a_crash() {
     let d = tmp("panic");
     let a = plate(&d, "a.exr", 16, 16, 0.0);
