@@ -10,17 +10,8 @@ use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 
-fn bundle() -> PathBuf {
-    common::bundle_path()
-}
-
 fn morphfx(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
-        .arg("--bundle")
-        .arg(bundle())
-        .args(args)
-        .output()
-        .expect("morphfx runs");
+    let out = common::run_morphfx(args);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stderr).into_owned(),
@@ -236,7 +227,7 @@ fn a_panic_inside_the_plugin_becomes_a_failure_status_not_a_crash() {
         .env("MORPHFX_FORCE_PANIC", "OfxImageEffectActionRender")
         .args([
             "--bundle",
-            bundle().to_str().unwrap(),
+            common::bundle_path().to_str().unwrap(),
             "warp",
             "--scene",
             d.join("s.morph.json").to_str().unwrap(),

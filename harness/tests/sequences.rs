@@ -11,17 +11,8 @@ use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 
-fn bundle() -> PathBuf {
-    common::bundle_path()
-}
-
 fn morphfx(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
-        .arg("--bundle")
-        .arg(bundle())
-        .args(args)
-        .output()
-        .expect("morphfx runs");
+    let out = common::run_morphfx(args);
     assert!(
         out.status.success(),
         "morphfx {args:?}: {}",
@@ -295,15 +286,15 @@ fn host_keyed_line_slots_interpolate_at_an_in_between_frame() {
     // Adaptive evaluation (the node's default): within its 0.05 px tolerance.
     assert_translation(&d.join("st.1006.exr"), (2.0, 0.0), 0.05 / 48.0);
     // A malformed slot is bad input, named.
-    let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
-        .arg("--bundle")
-        .arg(bundle())
-        .args(["warp", "--line", "17=1,2,3,4,5,6,7,8", "--input"])
-        .arg(d.join("a.1006.exr"))
-        .arg("-o")
-        .arg(d.join("never.exr"))
-        .output()
-        .unwrap();
+    let out = common::run_morphfx(&[
+        "warp",
+        "--line",
+        "17=1,2,3,4,5,6,7,8",
+        "--input",
+        s(&d.join("a.1006.exr")),
+        "-o",
+        s(&d.join("never.exr")),
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--line 17="));
     assert!(!d.join("never.exr").exists());

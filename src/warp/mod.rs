@@ -2,7 +2,6 @@
 //! to source positions (canonical coordinates), plus dense evaluation over a
 //! window of pixels (DESIGN rule 2).
 
-pub mod adaptive;
 pub mod field;
 mod map;
 

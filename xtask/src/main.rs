@@ -11,6 +11,26 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
+/// `cargo run ... --bin morphfx -- --bundle BUNDLE`, ready for a subcommand.
+fn morphfx(release: bool, bundle: &Path) -> Command {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let mut c = Command::new(cargo);
+    c.args([
+        "run",
+        "--quiet",
+        "--package",
+        "morphfx-harness",
+        "--bin",
+        "morphfx",
+    ])
+    .current_dir(root());
+    if release {
+        c.arg("--release");
+    }
+    c.arg("--").arg("--bundle").arg(bundle);
+    c
+}
+
 fn cargo(args: &[&str]) {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
@@ -65,22 +85,14 @@ fn main() {
         }
         Some("demo") => {
             let b = bundle(true);
-            let mut run = vec![
-                "run",
-                "--release",
-                "--quiet",
-                "--package",
-                "morphfx-harness",
-                "--bin",
-                "morphfx",
-                "--",
-                "--bundle",
-            ];
-            let b = b.to_string_lossy().into_owned();
-            run.push(&b);
-            run.push("demo");
-            run.extend(args[1..].iter().map(String::as_str));
-            cargo(&run);
+            let status = morphfx(true, &b)
+                .arg("demo")
+                .args(&args[1..])
+                .status()
+                .expect("cargo runs");
+            if !status.success() {
+                exit(status.code().unwrap_or(1));
+            }
         }
         Some("test") => {
             let b = bundle(false);
@@ -176,21 +188,8 @@ fn cmake_install_check() {
         prefix.as_os_str(),
     ]);
     let installed = prefix.join("OFX/Plugins/MorphFX.ofx.bundle");
-    let cargo_bin = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo_bin)
-        .args([
-            "run",
-            "--quiet",
-            "--package",
-            "morphfx-harness",
-            "--bin",
-            "morphfx",
-            "--",
-        ])
-        .arg("--bundle")
-        .arg(&installed)
+    let out = morphfx(false, &installed)
         .arg("plugins")
-        .current_dir(root())
         .output()
         .expect("morphfx runs");
     let listing = String::from_utf8_lossy(&out.stdout);

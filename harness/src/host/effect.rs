@@ -153,6 +153,7 @@ unsafe extern "C" fn get_property_set(
         return kOfxStatErrBadHandle;
     };
     if !props.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *props = e.props.handle() };
     }
     kOfxStatOK
@@ -166,6 +167,7 @@ unsafe extern "C" fn get_param_set(
         return kOfxStatErrBadHandle;
     };
     if !set.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *set = &e.params as *const ParamSet as OfxParamSetHandle };
     }
     kOfxStatOK
@@ -191,6 +193,7 @@ unsafe extern "C" fn clip_define(
         None => e.add_clip(&name, PropertySet::new()),
     };
     if !props.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *props = clip.props.handle() };
     }
     kOfxStatOK
@@ -213,6 +216,7 @@ unsafe extern "C" fn clip_get_handle(
     let Some(c) = e.clip(&name) else {
         return kOfxStatErrUnknown;
     };
+    // SAFETY: each out-pointer is written only when non-null; both are the plugin's variables.
     unsafe {
         if !clip.is_null() {
             *clip = c as *const Clip as OfxImageClipHandle;
@@ -232,6 +236,7 @@ unsafe extern "C" fn clip_get_property_set(
         return kOfxStatErrBadHandle;
     };
     if !props.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *props = c.props.handle() };
     }
     kOfxStatOK
@@ -347,6 +352,7 @@ unsafe extern "C" fn clip_get_rod(
         return kOfxStatFailed;
     };
     if !bounds.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe {
             *bounds = OfxRectD {
                 x1: r.x1 as f64,

@@ -198,6 +198,7 @@ unsafe extern "C" fn param_define(
     if kind.is_null() || name.is_null() {
         return kOfxStatErrBadHandle;
     }
+    // SAFETY: both checked non-null just above; OFX strings are NUL-terminated.
     let (kind, name) = unsafe { (CStr::from_ptr(kind), CStr::from_ptr(name)) };
     let name = name.to_string_lossy().into_owned();
     let mut params = set.params.lock().unwrap_or_else(|e| e.into_inner());
@@ -233,6 +234,7 @@ unsafe extern "C" fn param_get_handle(
     if name.is_null() {
         return kOfxStatErrBadHandle;
     }
+    // SAFETY: checked non-null just above; OFX strings are NUL-terminated.
     let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
     let Some(p) = set.find(&name) else {
         return kOfxStatErrUnknown;
@@ -258,6 +260,7 @@ unsafe extern "C" fn param_set_props(
         return kOfxStatErrBadHandle;
     };
     if !props.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *props = set.props.handle() };
     }
     kOfxStatOK
@@ -269,6 +272,7 @@ unsafe extern "C" fn param_props(h: OfxParamHandle, props: *mut OfxPropertySetHa
         return kOfxStatErrBadHandle;
     };
     if !props.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *props = p.props.handle() };
     }
     kOfxStatOK
@@ -280,6 +284,7 @@ unsafe extern "C" fn num_keys(h: OfxParamHandle, n: *mut c_uint) -> OfxStatus {
         return kOfxStatErrBadHandle;
     };
     if !n.is_null() {
+        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
         unsafe { *n = p.num_keys() as c_uint };
     }
     kOfxStatOK
@@ -347,6 +352,7 @@ pub unsafe extern "C" fn mfx_param_shape(
         Shape::Str => (2, 1),
         Shape::None => return kOfxStatErrValue,
     };
+    // SAFETY: the C shim passes pointers to its own locals (see varargs.c).
     unsafe {
         *kind = k;
         *dim = d as c_int;

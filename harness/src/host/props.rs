@@ -205,6 +205,7 @@ unsafe extern "C" fn get_string(
     i: c_int,
     out: *mut *mut c_char,
 ) -> OfxStatus {
+    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
     unsafe { get_any(h, n, i, out as *mut c_void, b's') }
 }
 unsafe extern "C" fn get_int(
@@ -213,6 +214,7 @@ unsafe extern "C" fn get_int(
     i: c_int,
     out: *mut c_int,
 ) -> OfxStatus {
+    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
     unsafe { get_any(h, n, i, out as *mut c_void, b'i') }
 }
 unsafe extern "C" fn get_double(
@@ -221,6 +223,7 @@ unsafe extern "C" fn get_double(
     i: c_int,
     out: *mut f64,
 ) -> OfxStatus {
+    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
     unsafe { get_any(h, n, i, out as *mut c_void, b'd') }
 }
 unsafe extern "C" fn get_pointer(
@@ -229,6 +232,7 @@ unsafe extern "C" fn get_pointer(
     i: c_int,
     out: *mut *mut c_void,
 ) -> OfxStatus {
+    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
     unsafe { get_any(h, n, i, out as *mut c_void, b'p') }
 }
 

@@ -2,6 +2,7 @@
 //! a scratch folder per test.
 
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// The bundle `cargo xtask test` built (MORPHFX_BUNDLE), else the checkout's.
 pub fn bundle_path() -> PathBuf {
@@ -19,4 +20,15 @@ pub fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// `morphfx --bundle <the built bundle> ARGS...`, run to completion.
+#[allow(dead_code)] // not every test file runs the binary
+pub fn run_morphfx(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_morphfx"))
+        .arg("--bundle")
+        .arg(bundle_path())
+        .args(args)
+        .output()
+        .expect("morphfx runs")
 }
