@@ -19,7 +19,7 @@ pub fn dissolve<S: Sample, D: Sample>(
     let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
     let (ca, cb) = (a.channels(), b.channels());
-    fill_rows(dst, dc, |j, x1, row| {
+    fill_rows(dst, dc, |j, x1, row, other| {
         let warped =
             |sampler: &Sampler<'_, S>, map: &WarpMap, channels: usize, out: &mut [[f32; 4]]| {
                 row_through(sampler, map, j, x1, out);
@@ -34,10 +34,11 @@ pub fn dissolve<S: Sample, D: Sample>(
         } else if wa == 0.0 {
             warped(b, map_b, cb, row);
         } else {
-            let mut other = vec![[0f32; 4]; row.len()];
+            // row_through writes every pixel, so the spare needs no clearing.
+            other.resize(row.len(), [0.0; 4]);
             warped(a, map_a, ca, row);
-            warped(b, map_b, cb, &mut other);
-            for (pa, pb) in row.iter_mut().zip(&other) {
+            warped(b, map_b, cb, other);
+            for (pa, pb) in row.iter_mut().zip(other.iter()) {
                 for c in 0..4 {
                     pa[c] = wa * pa[c] + wb * pb[c];
                 }

@@ -26,34 +26,37 @@ pub fn fill<D: Sample>(
     src_channels: usize,
     f: impl Fn(i32, i32, &mut [f32; 4]) + Sync,
 ) {
-    fill_rows(dst, src_channels, |j, x1, row| {
+    fill_rows(dst, src_channels, |j, x1, row, _| {
         for (k, px) in row.iter_mut().enumerate() {
             f(x1 + k as i32, j, px);
         }
     });
 }
 
-/// Row-at-a-time [`fill`]: `f(j, x1, row)` computes the pixels `x1..` of row `j`
-/// into `row` (in `src_channels` layout), which is then stored into `dst`.
+/// Row-at-a-time [`fill`]: `f(j, x1, row, spare)` computes the pixels `x1..`
+/// of row `j` into `row` (in `src_channels` layout), which is then stored into
+/// `dst`. `spare` is a buffer kept per worker for callers that need a second
+/// row (the dissolve), so no row allocates.
 pub fn fill_rows<D: Sample>(
     dst: RowsMut<'_, D>,
     src_channels: usize,
-    f: impl Fn(i32, i32, &mut [[f32; 4]]) + Sync,
+    f: impl Fn(i32, i32, &mut [[f32; 4]], &mut Vec<[f32; 4]>) + Sync,
 ) {
+    type Buffers = (Vec<[f32; 4]>, Vec<[f32; 4]>);
     let b = dst.bounds;
     let dc = dst.channels;
-    let work = |scratch: &mut Vec<[f32; 4]>, (j, row): (i32, &mut [D])| {
+    let work = |(scratch, spare): &mut Buffers, (j, row): (i32, &mut [D])| {
         scratch.clear();
         scratch.resize(b.width(), [0.0; 4]);
-        f(j, b.x1, scratch);
+        f(j, b.x1, scratch, spare);
         store(src_channels, dc, scratch, row);
     };
     let rows = dst.rows;
     if b.area() >= PARALLEL_MIN_PIXELS {
-        rows.into_par_iter().for_each_init(Vec::new, work);
+        rows.into_par_iter().for_each_init(Buffers::default, work);
     } else {
-        let mut scratch = Vec::new();
-        rows.into_iter().for_each(|r| work(&mut scratch, r));
+        let mut buffers = Buffers::default();
+        rows.into_iter().for_each(|r| work(&mut buffers, r));
     }
 }
 
@@ -112,7 +115,7 @@ pub fn resample<S: Sample, D: Sample>(
 
 /// `dst(i, j) = sampler(map(i, j))`.
 pub fn through<S: Sample, D: Sample>(sampler: &Sampler<'_, S>, map: &WarpMap, dst: RowsMut<'_, D>) {
-    fill_rows(dst, sampler.channels(), |j, x1, row| {
+    fill_rows(dst, sampler.channels(), |j, x1, row, _| {
         row_through(sampler, map, j, x1, row);
     });
 }
