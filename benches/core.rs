@@ -11,7 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use morphfx::geom::{PixelScale, RectI, Vec2};
 use morphfx::image::resample::{resample, ResampleSettings};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
-use morphfx::morph::dissolve;
+use morphfx::morph::{dissolve, Warped};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
 use morphfx::warp::{Warp, WarpMap};
 
@@ -148,7 +148,14 @@ fn bench_morph(c: &mut Criterion) {
         let sa = Sampler::new(a.view(), PixelScale::UNIT, filter, EdgeMode::Clamp, true);
         let sb = Sampler::new(b.view(), PixelScale::UNIT, filter, EdgeMode::Clamp, true);
         g.bench_function(format!("cached_warp_{}", filter.name()), |bch| {
-            bch.iter(|| dissolve(&sa, &map_a, &sb, &map_b, 0.37, dst.view_mut().rows()))
+            bch.iter(|| {
+                dissolve(
+                    Warped::Map(&sa, &map_a),
+                    Warped::Map(&sb, &map_b),
+                    0.37,
+                    dst.view_mut().rows(),
+                )
+            })
         });
     }
     g.finish();

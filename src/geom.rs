@@ -172,6 +172,37 @@ impl RectI {
     }
 }
 
+/// A rectangle in canonical coordinates `[x1, x2] × [y1, y2]` (OFX `OfxRectD`),
+/// e.g. the frame a warp must cover.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RectD {
+    pub x1: f64,
+    pub y1: f64,
+    pub x2: f64,
+    pub y2: f64,
+}
+
+impl RectD {
+    pub const fn new(x1: f64, y1: f64, x2: f64, y2: f64) -> Self {
+        RectD { x1, y1, x2, y2 }
+    }
+    #[inline]
+    pub fn width(&self) -> f64 {
+        self.x2 - self.x1
+    }
+    #[inline]
+    pub fn height(&self) -> f64 {
+        self.y2 - self.y1
+    }
+    pub fn is_valid(&self) -> bool {
+        [self.x1, self.y1, self.x2, self.y2]
+            .iter()
+            .all(|v| v.is_finite())
+            && self.x2 > self.x1
+            && self.y2 > self.y1
+    }
+}
+
 /// How pixel indices of an image at some render scale relate to canonical
 /// coordinates: `canonical = pixel / scale` per axis, where `scale.x` already
 /// folds in the pixel aspect ratio (`render_scale.x / par`).

@@ -2,42 +2,79 @@
 //! and dissolved (seed 002 §3.4).
 
 use crate::image::resample::{adapt_channels, fill_rows, row_through};
-use crate::image::{RowsMut, Sample, Sampler};
+use crate::image::{Plane, RowsMut, Sample, Sampler};
 use crate::warp::WarpMap;
 
-/// `dst = (1 − t) · A(map_a) + t · B(map_b)`, in `dst`'s channel layout.
+/// A warped source as the dissolve reads it: resampled through a reverse
+/// map, or pixels a warp made directly (the two-pass mesh warp).
+#[derive(Clone, Copy)]
+pub enum Warped<'a, S> {
+    Map(&'a Sampler<'a, S>, &'a WarpMap),
+    Pixels(&'a Plane),
+}
+
+impl<S: Sample> Warped<'_, S> {
+    pub fn channels(&self) -> usize {
+        match self {
+            Warped::Map(s, _) => s.channels(),
+            Warped::Pixels(p) => p.channels,
+        }
+    }
+
+    /// Pixels `x1..` of row `j` into `out`, in [`Warped::channels`] layout;
+    /// transparent black outside what the warp covers.
+    pub fn row(&self, j: i32, x1: i32, out: &mut [[f32; 4]]) {
+        match self {
+            Warped::Map(sampler, map) => row_through(sampler, map, j, x1, out),
+            Warped::Pixels(plane) => {
+                let w = plane.window;
+                let x2 = x1 + out.len() as i32;
+                let (lo, hi) = (x1.max(w.x1), x2.min(w.x2));
+                out.fill([0.0; 4]);
+                if j >= w.y1 && j < w.y2 && lo < hi {
+                    let src = &plane.row(j)[(lo - w.x1) as usize..(hi - w.x1) as usize];
+                    out[(lo - x1) as usize..(hi - x1) as usize].copy_from_slice(src);
+                }
+            }
+        }
+    }
+}
+
+/// One warped source written into `dst`'s layout.
+pub fn show<S: Sample, D: Sample>(src: Warped<'_, S>, dst: RowsMut<'_, D>) {
+    fill_rows(dst, src.channels(), |j, x1, row, _| src.row(j, x1, row));
+}
+
+/// `dst = (1 − t) · A + t · B` of the warped sources, in `dst`'s channel layout.
 /// At `t = 0` B is not read at all (and A not at `t = 1`), so the end frames are
 /// exactly the warped source, whatever the other holds (even NaN).
 pub fn dissolve<S: Sample, D: Sample>(
-    a: &Sampler<'_, S>,
-    map_a: &WarpMap,
-    b: &Sampler<'_, S>,
-    map_b: &WarpMap,
+    a: Warped<'_, S>,
+    b: Warped<'_, S>,
     t: f64,
     dst: RowsMut<'_, D>,
 ) {
     let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
-    let (ca, cb) = (a.channels(), b.channels());
     fill_rows(dst, dc, |j, x1, row, other| {
-        let warped =
-            |sampler: &Sampler<'_, S>, map: &WarpMap, channels: usize, out: &mut [[f32; 4]]| {
-                row_through(sampler, map, j, x1, out);
-                if channels != dc {
-                    for px in out.iter_mut() {
-                        *px = adapt_channels(channels, dc, *px);
-                    }
+        let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| {
+            src.row(j, x1, out);
+            let channels = src.channels();
+            if channels != dc {
+                for px in out.iter_mut() {
+                    *px = adapt_channels(channels, dc, *px);
                 }
-            };
+            }
+        };
         if wb == 0.0 {
-            warped(a, map_a, ca, row);
+            warped(&a, row);
         } else if wa == 0.0 {
-            warped(b, map_b, cb, row);
+            warped(&b, row);
         } else {
-            // row_through writes every pixel, so the spare needs no clearing.
+            // Every pixel is written, so the spare needs no clearing.
             other.resize(row.len(), [0.0; 4]);
-            warped(a, map_a, ca, row);
-            warped(b, map_b, cb, other);
+            warped(&a, row);
+            warped(&b, other);
             for (pa, pb) in row.iter_mut().zip(other.iter()) {
                 for c in 0..4 {
                     pa[c] = wa * pa[c] + wb * pb[c];

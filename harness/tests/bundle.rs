@@ -10,7 +10,7 @@ mod common;
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, RectI, Vec2};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
-use morphfx::morph::dissolve;
+use morphfx::morph::{dissolve, Warped};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp};
 use morphfx::warp::Warp;
 use morphfx_harness::host::{Bundle, Frame, FrameSource, OutputSpec};
@@ -157,7 +157,12 @@ fn expected(case: &Case, a: &Image, b: &Image) -> Image {
     let sa = Sampler::new(a.view(), scale, Filter::Bilinear, EdgeMode::Clamp, true);
     let sb = Sampler::new(b.view(), scale, Filter::Bilinear, EdgeMode::Clamp, true);
     let mut out = Image::new(full, case.channels);
-    dissolve(&sa, &ma, &sb, &mb, T, out.view_mut().rows());
+    dissolve(
+        Warped::Map(&sa, &ma),
+        Warped::Map(&sb, &mb),
+        T,
+        out.view_mut().rows(),
+    );
     out
 }
 

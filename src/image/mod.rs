@@ -270,3 +270,27 @@ impl Image {
 
 #[cfg(test)]
 mod tests;
+
+/// Float pixels over a window, `[f32; 4]` each in some channel layout (1, 3
+/// or 4 channels used), rows bottom-up: what a warp that makes pixels rather
+/// than a map (the two-pass mesh warp) hands to the dissolve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plane {
+    pub window: RectI,
+    pub channels: usize,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+impl Plane {
+    /// Row `j` (inside the window).
+    #[inline]
+    pub fn row(&self, j: i32) -> &[[f32; 4]] {
+        let w = self.window.width();
+        let start = (j - self.window.y1) as usize * w;
+        &self.pixels[start..start + w]
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        self.pixels.len() * std::mem::size_of::<[f32; 4]>()
+    }
+}

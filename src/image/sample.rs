@@ -59,7 +59,7 @@ impl EdgeMode {
 
     /// The in-bounds index `k` reads from, for an axis `[lo, hi)`.
     #[inline]
-    fn resolve(self, k: i32, lo: i32, hi: i32) -> Option<i32> {
+    pub(crate) fn resolve(self, k: i32, lo: i32, hi: i32) -> Option<i32> {
         if k >= lo && k < hi {
             return Some(k);
         }
@@ -117,6 +117,22 @@ impl<'a, T: Sample> Sampler<'a, T> {
     #[inline]
     pub fn bounds(&self) -> RectI {
         self.view.bounds()
+    }
+
+    #[inline]
+    pub fn scale(&self) -> PixelScale {
+        self.scale
+    }
+
+    #[inline]
+    pub fn edge(&self) -> EdgeMode {
+        self.edge
+    }
+
+    /// Whether colour is weighted by alpha while filtering (straight RGBA).
+    #[inline]
+    pub fn alpha_weighted(&self) -> bool {
+        self.alpha_weighted
     }
 
     /// The source pixel `(i, j)` itself, if inside the bounds.

@@ -39,7 +39,12 @@ fn render(t: f64, features: &[Feature]) -> Image {
         true,
     );
     let mut out = Image::new(a.bounds, 4);
-    dissolve(&sa, &wa, &sb, &wb, t, out.view_mut().rows());
+    dissolve(
+        Warped::Map(&sa, &wa),
+        Warped::Map(&sb, &wb),
+        t,
+        out.view_mut().rows(),
+    );
     out
 }
 

@@ -7,6 +7,7 @@ mod tests;
 
 use crate::features::{Feature, DEFAULT_SAMPLES_PER_SEGMENT};
 use crate::warp::field::FieldSettings;
+use crate::warp::mesh::{MeshPair, MeshSettings};
 
 pub use parse::FORMAT;
 
@@ -53,7 +54,17 @@ impl Method {
     /// Whether this build can render the method. The others are accepted in
     /// scenes (so files stay valid) but refuse to render with a clear message.
     pub fn is_available(self) -> bool {
-        matches!(self, Method::Field)
+        matches!(self, Method::Field | Method::Mesh | Method::Triangles)
+    }
+
+    /// The methods this build renders, for messages: `field, mesh, ...`.
+    pub fn available_names() -> String {
+        let names: Vec<_> = Self::ALL
+            .iter()
+            .filter(|m| m.is_available())
+            .map(|m| m.name())
+            .collect();
+        names.join(", ")
     }
 
     /// Methods that cannot do anything without features (`auto` finds its own
@@ -74,6 +85,11 @@ pub struct Keyframe {
 pub struct Scene {
     pub method: Method,
     pub field: FieldSettings,
+    /// Mesh method settings (scene key `mesh`).
+    pub mesh: MeshSettings,
+    /// The mesh pair: one static pair, or pairs keyed at frames (sorted,
+    /// strictly increasing), interpolated like feature keyframes.
+    pub meshes: Vec<(f64, MeshPair)>,
     /// Samples per polyline/curve span for point-based methods (seed 000 §4.2).
     pub samples_per_segment: usize,
     /// The features when there are no keyframes.
@@ -92,6 +108,8 @@ impl Default for Scene {
         Scene {
             method: Method::Field,
             field: FieldSettings::default(),
+            mesh: MeshSettings::default(),
+            meshes: Vec::new(),
             samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
             features: Vec::new(),
             keyframes: Vec::new(),
@@ -124,6 +142,21 @@ impl Scene {
                 b: lerp_points(&f0.b, &f1.b, w),
             })
             .collect()
+    }
+
+    /// The mesh pair at `frame`: keys interpolated linearly in frame and held
+    /// outside the keyed range (a static mesh is one key).
+    pub fn mesh_at(&self, frame: f64) -> Option<MeshPair> {
+        let keys = &self.meshes;
+        if keys.is_empty() {
+            return None;
+        }
+        let (lo, hi, w) = bracket(keys.len(), |i| keys[i].0, frame);
+        Some(if w == 0.0 {
+            keys[lo].1.clone()
+        } else {
+            keys[lo].1.lerp(&keys[hi].1, w)
+        })
     }
 
     /// Progress `t` at `frame`, if the scene keys it (linear between keys, held outside).

@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::features::{Feature, FeatureKind};
 use crate::geom::Vec2;
 use crate::warp::field::{Evaluation, FieldSettings, LineInterpolation};
+use crate::warp::mesh::{Mesh, MeshPair, MeshSettings, Pass};
 
 pub const FORMAT: &str = "morphfx-scene";
 
@@ -19,6 +20,7 @@ struct RawScene {
     method: Option<String>,
     field: Option<RawField>,
     sampling: Option<RawSampling>,
+    mesh: Option<RawMesh>,
     features: Option<Vec<RawFeature>>,
     keyframes: Option<Vec<RawKeyframe>>,
     progress: Option<Vec<[f64; 2]>>,
@@ -42,6 +44,25 @@ struct RawField {
 #[serde(deny_unknown_fields)]
 struct RawSampling {
     samples_per_segment: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMesh {
+    rows: usize,
+    cols: usize,
+    a: Option<Vec<[f64; 2]>>,
+    b: Option<Vec<[f64; 2]>>,
+    pass: Option<String>,
+    keyframes: Option<Vec<RawMeshKey>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMeshKey {
+    frame: f64,
+    a: Vec<[f64; 2]>,
+    b: Vec<[f64; 2]>,
 }
 
 #[derive(Deserialize)]
@@ -109,6 +130,16 @@ impl Scene {
             None => crate::features::DEFAULT_SAMPLES_PER_SEGMENT,
         };
 
+        let (mesh, meshes) = match raw.mesh {
+            Some(m) => mesh(m)?,
+            None => (MeshSettings::default(), Vec::new()),
+        };
+        if method == Method::Mesh && meshes.is_empty() {
+            return Err(Error::scene(
+                "mesh",
+                "method \"mesh\" needs a mesh: {\"rows\": R, \"cols\": C, \"a\": [...], \"b\": [...]}",
+            ));
+        }
         let features = match raw.features {
             Some(list) => features(list, "")?,
             None => Vec::new(),
@@ -124,6 +155,8 @@ impl Scene {
         let scene = Scene {
             method,
             field,
+            mesh,
+            meshes,
             samples_per_segment,
             features,
             keyframes,
@@ -206,6 +239,58 @@ fn field_settings(raw: RawField) -> Result<FieldSettings> {
         evaluation,
         curve_samples,
     })
+}
+
+/// The mesh settings and the mesh pair(s), keyed or static, each checked by
+/// the rules of [`MeshPair::new`] with the place named.
+fn mesh(raw: RawMesh) -> Result<(MeshSettings, Vec<(f64, MeshPair)>)> {
+    let pass = match raw.pass.as_deref() {
+        None => Pass::default(),
+        Some(p) => Pass::parse(p).ok_or_else(|| {
+            Error::scene(
+                "mesh.pass",
+                format!("unknown pass \"{p}\" (two-pass or one-pass)"),
+            )
+        })?,
+    };
+    let (rows, cols) = (raw.rows, raw.cols);
+    let pair = |a: Vec<[f64; 2]>, b: Vec<[f64; 2]>, at: &str| -> Result<MeshPair> {
+        let side = |pts: Vec<[f64; 2]>, name: &str| {
+            Mesh::new(rows, cols, pts.into_iter().map(Vec2::from).collect())
+                .map_err(|e| Error::scene(format!("{at}.{name}"), e.to_string()))
+        };
+        MeshPair::new(side(a, "a")?, side(b, "b")?).map_err(|e| Error::scene(at, e.to_string()))
+    };
+    let mut keys = Vec::new();
+    match (raw.keyframes, raw.a, raw.b) {
+        (Some(list), _, _) if !list.is_empty() => {
+            for (i, k) in list.into_iter().enumerate() {
+                let at = format!("mesh.keyframes[{i}] (frame {})", k.frame);
+                if !k.frame.is_finite() {
+                    return Err(Error::scene(
+                        format!("mesh.keyframes[{i}]"),
+                        "frame is not a finite number",
+                    ));
+                }
+                keys.push((k.frame, pair(k.a, k.b, &at)?));
+            }
+            keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some(w) = keys.windows(2).find(|w| w[0].0 == w[1].0) {
+                return Err(Error::scene(
+                    "mesh.keyframes",
+                    format!("frame {} is keyed twice", w[0].0),
+                ));
+            }
+        }
+        (_, Some(a), Some(b)) => keys.push((0.0, pair(a, b, "mesh")?)),
+        _ => {
+            return Err(Error::scene(
+                "mesh",
+                "needs node positions: \"a\" and \"b\" (rows × cols points each, bottom row first), or \"keyframes\"",
+            ))
+        }
+    }
+    Ok((MeshSettings { pass }, keys))
 }
 
 fn features(list: Vec<RawFeature>, prefix: &str) -> Result<Vec<Feature>> {

@@ -139,3 +139,78 @@ fn unknown_methods_settings_are_kept() {
     assert_eq!(s.method, Method::Auto);
     assert!(s.extra.contains_key("auto"));
 }
+
+/// A 3 × 3 mesh over 0..20 whose centre node moves from (10, 10) to `centre`.
+fn mesh_json(centre: [f64; 2]) -> String {
+    let a = "[[0,0],[10,0],[20,0],[0,10],[10,10],[20,10],[0,20],[10,20],[20,20]]";
+    let b = format!(
+        "[[0,0],[10,0],[20,0],[0,10],[{},{}],[20,10],[0,20],[10,20],[20,20]]",
+        centre[0], centre[1]
+    );
+    format!(r#""rows": 3, "cols": 3, "a": {a}, "b": {b}"#)
+}
+
+#[test]
+fn mesh_scenes_parse_with_pass_and_keyframes() {
+    let s = Scene::parse(&format!(
+        r#"{{"method": "mesh", "mesh": {{ {}, "pass": "one-pass" }} }}"#,
+        mesh_json([12.0, 9.0])
+    ))
+    .unwrap();
+    assert_eq!(s.method, Method::Mesh);
+    assert_eq!(s.mesh.pass, crate::warp::mesh::Pass::OnePass);
+    let pair = s.mesh_at(5.0).unwrap();
+    assert_eq!(pair.b.node(1, 1), crate::Vec2::new(12.0, 9.0));
+
+    let a = "[[0,0],[10,0],[20,0],[0,10],[10,10],[20,10],[0,20],[10,20],[20,20]]";
+    let keyed = Scene::parse(&format!(
+        r#"{{"method": "mesh", "mesh": {{"rows": 3, "cols": 3, "keyframes": [
+            {{"frame": 10, "a": {a}, "b": {a}}},
+            {{"frame": 20, "a": {a}, "b": [[0,0],[10,0],[20,0],[0,10],[14,12],[20,10],[0,20],[10,20],[20,20]]}}
+        ]}}}}"#
+    ))
+    .unwrap();
+    assert_eq!(
+        keyed.mesh_at(15.0).unwrap().b.node(1, 1),
+        crate::Vec2::new(12.0, 11.0)
+    );
+    assert_eq!(
+        keyed.mesh_at(0.0).unwrap().b.node(1, 1),
+        crate::Vec2::new(10.0, 10.0)
+    );
+}
+
+#[test]
+fn bad_meshes_name_the_mesh_and_the_place() {
+    // Method mesh without a mesh.
+    let (at, msg) = err(r#"{"method": "mesh"}"#);
+    assert_eq!(at, "mesh");
+    assert!(msg.contains("needs a mesh"), "{msg}");
+    // The centre node dragged across its right neighbour column.
+    let (at, msg) = err(&format!(
+        r#"{{"method": "mesh", "mesh": {{ {} }} }}"#,
+        mesh_json([25.0, 10.0])
+    ));
+    assert_eq!(at, "mesh");
+    assert!(msg.contains("mesh b") && msg.contains("row 1"), "{msg}");
+    // Wrong node count, with the side named.
+    let (at, msg) = err(
+        r#"{"method": "mesh", "mesh": {"rows": 2, "cols": 2, "a": [[0,0],[1,0],[0,1]], "b": [[0,0],[1,0],[0,1],[1,1]]}}"#,
+    );
+    assert_eq!(at, "mesh.a");
+    assert!(msg.contains("4 nodes, found 3"), "{msg}");
+    // Unknown pass and unknown keys.
+    let (at, _) = err(&format!(
+        r#"{{"mesh": {{ {}, "pass": "three-pass" }} }}"#,
+        mesh_json([10.0, 10.0])
+    ));
+    assert_eq!(at, "mesh.pass");
+    let (at, msg) = err(&format!(
+        r#"{{"mesh": {{ {}, "passes": 2 }} }}"#,
+        mesh_json([10.0, 10.0])
+    ));
+    assert!(
+        at.starts_with("line") && msg.contains("passes"),
+        "{at}: {msg}"
+    );
+}

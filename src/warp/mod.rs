@@ -4,6 +4,8 @@
 
 pub mod field;
 mod map;
+pub mod mesh;
+pub mod triangles;
 
 pub use map::WarpMap;
 
@@ -77,15 +79,26 @@ use std::sync::Arc;
 
 use crate::error::{Error, Result};
 use crate::features::{Feature, Side, DEFAULT_SAMPLES_PER_SEGMENT};
+use crate::geom::RectD;
 use crate::scene::{Method, Scene};
 use field::{FieldSettings, FieldWarp};
+use mesh::{MeshPair, MeshSettings, MeshWarp};
+use triangles::TriangleWarp;
 
-/// Everything a warp generator depends on besides the features.
+/// Everything a warp generator depends on besides the features: the method,
+/// its settings, and the per-frame inputs some methods need (the mesh pair at
+/// this frame, the frame the warp must cover).
 #[derive(Debug, Clone, PartialEq)]
 pub struct WarpSettings {
     pub method: Method,
     pub field: FieldSettings,
+    pub mesh: MeshSettings,
     pub samples_per_segment: usize,
+    /// The mesh pair at this frame (method `mesh`).
+    pub meshes: Option<MeshPair>,
+    /// The frame (canonical) whose border `triangles` pins; without it, the
+    /// features' bounds grown by half their size on each side.
+    pub frame: Option<RectD>,
 }
 
 impl Default for WarpSettings {
@@ -93,23 +106,31 @@ impl Default for WarpSettings {
         WarpSettings {
             method: Method::Field,
             field: FieldSettings::default(),
+            mesh: MeshSettings::default(),
             samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
+            meshes: None,
+            frame: None,
         }
     }
 }
 
-impl From<&Scene> for WarpSettings {
-    fn from(s: &Scene) -> Self {
+impl WarpSettings {
+    /// The scene's settings and its mesh pair at `frame`.
+    pub fn from_scene(s: &Scene, frame: f64) -> Self {
         WarpSettings {
             method: s.method,
             field: s.field,
+            mesh: s.mesh,
             samples_per_segment: s.samples_per_segment,
+            meshes: s.mesh_at(frame),
+            frame: None,
         }
     }
 }
 
 /// The warp of the image on `side` toward the features' positions at `t`
-/// (`t = 0`: A's positions, `t = 1`: B's).
+/// (`t = 0`: A's positions, `t = 1`: B's), as a reverse map. For `mesh` this
+/// is the one-pass map; the two-pass warp makes pixels ([`mesh::two_pass`]).
 pub fn toward(
     features: &[Feature],
     side: Side,
@@ -123,9 +144,49 @@ pub fn toward(
             t,
             &settings.field,
         ))),
+        Method::Mesh => {
+            let pair = settings.meshes.as_ref().ok_or_else(|| {
+                Error::Invalid(
+                    "method \"mesh\" needs a mesh (scene key \"mesh\" with rows, cols, a and b)"
+                        .into(),
+                )
+            })?;
+            Ok(Arc::new(MeshWarp::toward(pair, side, t)))
+        }
+        Method::Triangles => {
+            let frame = match settings.frame {
+                Some(f) => f,
+                None => feature_bounds(features).ok_or_else(|| {
+                    Error::Invalid("method \"triangles\" needs at least one feature point".into())
+                })?,
+            };
+            Ok(Arc::new(TriangleWarp::toward(
+                features,
+                side,
+                t,
+                settings.samples_per_segment,
+                frame,
+            )?))
+        }
         m => Err(Error::Unsupported(format!(
-            "method \"{}\" is not available in this build yet (available: field)",
-            m.name()
+            "method \"{}\" is not available in this build yet (available: {})",
+            m.name(),
+            Method::available_names()
         ))),
     }
+}
+
+/// The bounds of every feature point on both sides, grown by half their size
+/// on each side (at least 16 px).
+fn feature_bounds(features: &[Feature]) -> Option<RectD> {
+    let pts = features.iter().flat_map(|f| f.a.iter().chain(&f.b));
+    let mut r: Option<RectD> = None;
+    for p in pts {
+        let b = r.get_or_insert(RectD::new(p.x, p.y, p.x, p.y));
+        *b = RectD::new(b.x1.min(p.x), b.y1.min(p.y), b.x2.max(p.x), b.y2.max(p.y));
+    }
+    r.map(|b| {
+        let (mx, my) = ((b.width() * 0.5).max(16.0), (b.height() * 0.5).max(16.0));
+        RectD::new(b.x1 - mx, b.y1 - my, b.x2 + mx, b.y2 + my)
+    })
 }
