@@ -6,6 +6,7 @@ use morphfx::image::{EdgeMode, Filter};
 use morphfx::scene::Method;
 use morphfx::views::View;
 use morphfx::warp::field::{Evaluation, FieldSettings, LineInterpolation};
+use morphfx::warp::mesh::{MeshSettings, Pass};
 
 use super::spec::{Kind, ParamSpec, TextMode};
 use super::NodeKind;
@@ -32,6 +33,7 @@ pub const OFFSET_B: &str = "frame_offset_b";
 pub const FILTER: &str = "filter";
 pub const EDGE: &str = "edge";
 pub const VIEW: &str = "view";
+pub const MESH_PASS: &str = "mesh_pass";
 
 /// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
 pub fn slot_ids(k: usize) -> [String; 5] {
@@ -49,8 +51,8 @@ fn method_options() -> Vec<&'static str> {
         .iter()
         .map(|m| match m {
             Method::Field => "field",
-            Method::Mesh => "mesh (not yet available)",
-            Method::Triangles => "triangles (not yet available)",
+            Method::Mesh => "mesh",
+            Method::Triangles => "triangles",
             Method::ThinPlate => "thin-plate (not yet available)",
             Method::Mffd => "mffd (not yet available)",
             Method::Hybrid => "hybrid (not yet available)",
@@ -78,7 +80,7 @@ fn view_label(kind: NodeKind, v: View) -> &'static str {
 pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
     let d = FieldSettings::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. Only field is available in this build; the others refuse to render.", Kind::Choice { options: method_options(), default: 0 }),
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine. Methods marked not yet available refuse to render.", Kind::Choice { options: method_options(), default: 0 }),
         ParamSpec::new(
             PROGRESS,
             "Progress",
@@ -94,6 +96,8 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(INTERPOLATION, "Line Interpolation", "endpoints: endpoints move straight; center-angle: centre, angle and length interpolate (rotating lines keep their length).", Kind::Choice { options: vec!["endpoints", "center-angle"], default: 0 }).in_group("field_group"),
         ParamSpec::new(EVALUATION, "Evaluation", "adaptive: coarse grid refined where needed, within Tolerance of exact; exact: every pixel.", Kind::Choice { options: vec!["adaptive", "exact"], default: 0 }).in_group("field_group"),
         ParamSpec::new(TOLERANCE, "Tolerance", "Largest error of the adaptive evaluation, in pixels.", Kind::Double { default: Evaluation::DEFAULT_TOLERANCE, min: 0.001, max: 5.0, display: (0.01, 1.0) }).in_group("field_group").animated(false),
+        ParamSpec::new("mesh_group", "Mesh", "Mesh warp (the mesh comes from the scene's \"mesh\" key)", Kind::Group { open: false }),
+        ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", Kind::Choice { options: vec!["two-pass", "one-pass"], default: 0 }).in_group("mesh_group").animated(false),
         ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
     ];
@@ -228,6 +232,7 @@ pub struct Settings {
     pub use_scene_progress: bool,
     pub settings_from_scene: bool,
     pub field: FieldSettings,
+    pub mesh: MeshSettings,
     pub lines: Vec<Feature>,
     pub scene_file: String,
     pub scene_text: String,
@@ -274,6 +279,11 @@ impl Settings {
             Evaluation::Exact
         } else {
             Evaluation::Adaptive { tolerance }
+        };
+        let pass = if int_or(MESH_PASS, 0) == 1 {
+            Pass::OnePass
+        } else {
+            Pass::TwoPass
         };
         let count = int_or(LINE_COUNT, 0).clamp(0, LINE_SLOTS as i32) as usize;
         let offset_a = int_or(OFFSET_A, 0);
@@ -329,6 +339,7 @@ impl Settings {
                 evaluation,
                 curve_samples: d.curve_samples,
             },
+            mesh: MeshSettings { pass },
             lines,
             scene_file,
             scene_text,

@@ -4,12 +4,13 @@
 use std::sync::Arc;
 
 use morphfx::features::{Feature, Side};
-use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::resample::through;
-use morphfx::image::{ImageView, RowsMut, Sample, Sampler};
-use morphfx::morph::dissolve;
-use morphfx::scene::Scene;
+use morphfx::image::{ImageView, Plane, RowsMut, Sample, Sampler};
+use morphfx::morph::{dissolve, show, Warped};
+use morphfx::scene::{Method, Scene};
 use morphfx::views::{self, View};
+use morphfx::warp::mesh::{self, MeshPair, Pass};
 use morphfx::warp::{self, WarpMap, WarpSettings};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
@@ -178,13 +179,16 @@ fn frame_at(
     let mut warp = WarpSettings {
         method: settings.method,
         field: settings.field,
+        mesh: settings.mesh,
         ..WarpSettings::default()
     };
     let mut t = settings.progress;
     if let Some(scene) = &scene {
         features.extend(scene.features_at(time));
         if settings.settings_from_scene {
-            warp = WarpSettings::from(&**scene);
+            warp = WarpSettings::from_scene(scene, time);
+        } else {
+            warp.meshes = scene.mesh_at(time);
         }
         if settings.use_scene_progress {
             t = scene.progress_at(time).unwrap_or(t);
@@ -223,11 +227,12 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
             ),
         );
     }
-    let frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
+    let mut frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
     if !frame.warp.method.is_available() {
         return Err(Failure::BadInput(format!(
-            "method \"{}\" is not available in this build yet (available: field)",
-            frame.warp.method.name()
+            "method \"{}\" is not available in this build yet (available: {})",
+            frame.warp.method.name(),
+            morphfx::scene::Method::available_names()
         )));
     }
 
@@ -253,6 +258,19 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     // Maps cover the whole output frame so tiles of one frame share one cached map.
     let (format_clip, _) = format_clip(kind, effect, &context)?;
     let rod = format_clip.rod(time)?;
+    // Triangles pin the border of the frame, so the whole frame warps.
+    frame.warp.frame = Some(RectD::new(rod.x1, rod.y1, rod.x2, rod.y2));
+    // The two-pass mesh warp makes pixels (per render window), not a map:
+    // pictures take that path, ST maps and the grid the one-pass map.
+    let two_pass =
+        match (&frame.warp.method, &frame.warp.meshes) {
+            (Method::Mesh, Some(_)) => frame.warp.mesh.pass == Pass::TwoPass,
+            (Method::Mesh, None) => return Err(Failure::BadInput(
+                "method \"mesh\" needs a mesh: put a \"mesh\" key (rows, cols, a, b) in the scene"
+                    .into(),
+            )),
+            _ => false,
+        };
     let full = RectI::new(
         (rod.x1 * scale.x).floor() as i32,
         (rod.y1 * scale.y).floor() as i32,
@@ -271,20 +289,28 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         return Ok(());
     }
     let (origin, size) = project(effect, &rod);
+    let picture = matches!(settings.view, View::Morph | View::WarpedA | View::WarpedB);
+    let by_map = !(two_pass && picture);
     let job = Job {
         view: settings.view,
         t: frame.t,
         features: &frame.features,
-        map_a: if needs_a(settings.view) {
+        map_a: if needs_a(settings.view) && by_map {
             Some(map(Side::A)?)
         } else {
             None
         },
-        map_b: if needs_b(kind, settings.view) {
+        map_b: if needs_b(kind, settings.view) && by_map {
             Some(map(Side::B)?)
         } else {
             None
         },
+        meshes: if by_map {
+            None
+        } else {
+            frame.warp.meshes.as_ref()
+        },
+        scale,
         origin,
         size,
     };
@@ -368,6 +394,9 @@ struct Job<'a> {
     features: &'a [Feature],
     map_a: Option<Arc<WarpMap>>,
     map_b: Option<Arc<WarpMap>>,
+    /// The mesh pair when pictures come from the two-pass mesh warp.
+    meshes: Option<&'a MeshPair>,
+    scale: PixelScale,
     origin: Vec2,
     size: Vec2,
 }
@@ -379,11 +408,17 @@ impl Job<'_> {
         b: Option<&Sampler<'_, S>>,
         rows: RowsMut<'_, D>,
     ) {
+        if let Some(pair) = self.meshes {
+            return self.draw_two_pass(pair, a, b, rows);
+        }
         let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
         match (self.view, b) {
-            (View::Morph, Some(b)) => {
-                dissolve(a, ma.expect("map A"), b, mb.expect("map B"), self.t, rows)
-            }
+            (View::Morph, Some(b)) => dissolve(
+                Warped::Map(a, ma.expect("map A")),
+                Warped::Map(b, mb.expect("map B")),
+                self.t,
+                rows,
+            ),
             (View::Morph | View::WarpedA, _) => through(a, ma.expect("map A"), rows),
             (View::WarpedB, Some(b)) => through(b, mb.expect("map B"), rows),
             (View::StmapA, _) => views::stmap(ma.expect("map A"), self.origin, self.size, rows),
@@ -394,5 +429,53 @@ impl Job<'_> {
             (View::Grid, _) => views::grid(ma.expect("map A"), self.features, self.t, rows),
             (View::WarpedB, None) => through(a, ma.expect("map A"), rows),
         }
+    }
+
+    /// Pictures through the two-pass mesh warp, made for this render window
+    /// only (its cost follows the window, so tiles stay cheap; nothing that
+    /// depends on the host's pixels is cached). A side whose mesh does not
+    /// move is copied, not filtered.
+    fn draw_two_pass<S: Sample, D: Sample>(
+        &self,
+        pair: &MeshPair,
+        a: &Sampler<'_, S>,
+        b: Option<&Sampler<'_, S>>,
+        rows: RowsMut<'_, D>,
+    ) {
+        let window = rows.bounds;
+        let to = pair.at(self.t);
+        let identity = WarpMap::identity(window, self.scale);
+        let plane = |side: Side, s: &Sampler<'_, S>| {
+            let from = pair.side(side);
+            (*from != to).then(|| mesh::two_pass(s, from, &to, window, self.scale))
+        };
+        match (self.view, b) {
+            (View::Morph, Some(b)) => {
+                let (pa, pb) = (
+                    (self.t < 1.0).then(|| plane(Side::A, a)).flatten(),
+                    (self.t > 0.0).then(|| plane(Side::B, b)).flatten(),
+                );
+                dissolve(
+                    warped(a, &pa, &identity),
+                    warped(b, &pb, &identity),
+                    self.t,
+                    rows,
+                )
+            }
+            (View::WarpedB, Some(b)) => show(warped(b, &plane(Side::B, b), &identity), rows),
+            _ => show(warped(a, &plane(Side::A, a), &identity), rows),
+        }
+    }
+}
+
+/// A two-pass side: its pixels, or the source itself when its mesh stays put.
+fn warped<'a, S: Sample>(
+    source: &'a Sampler<'a, S>,
+    plane: &'a Option<Plane>,
+    identity: &'a WarpMap,
+) -> Warped<'a, S> {
+    match plane {
+        Some(p) => Warped::Pixels(p),
+        None => Warped::Map(source, identity),
     }
 }
