@@ -1,5 +1,5 @@
-//! Core engine benchmarks (issue "core engine"): the field map at 1080p, resampling
-//! and a whole morph frame. Numbers and the machine go in docs/PERFORMANCE.md.
+//! Core engine benchmarks: the field map at 1080p, resampling, a whole morph
+//! frame, the mesh warp (two-pass and one-pass) and triangles. Numbers and the machine go in docs/PERFORMANCE.md.
 //!
 //! `cargo bench --bench core` (add `-- field` etc. to pick a group).
 
@@ -8,11 +8,14 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::features::{Feature, Side};
+use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::resample::{resample, ResampleSettings};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
+use morphfx::warp::mesh::{self, Mesh, MeshWarp};
+use morphfx::warp::triangles::TriangleWarp;
 use morphfx::warp::{Warp, WarpMap};
 
 const W: i32 = 1920;
@@ -161,5 +164,84 @@ fn bench_morph(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_field, bench_resample, bench_morph);
+/// A 20 × 20 mesh on the frame, interior nodes pushed up to 25 px by a smooth
+/// field (border frozen), as a hand-placed face mesh moves.
+fn mesh_pair() -> (Mesh, Mesh) {
+    let src = Mesh::regular(20, 20, 0.0, 0.0, W as f64, H as f64).unwrap();
+    let dst = src.map_nodes(|r, c, p| {
+        if r == 0 || c == 0 || r == 19 || c == 19 {
+            p
+        } else {
+            p + Vec2::new(25.0 * (p.y * 0.004).sin(), 18.0 * (p.x * 0.003).cos())
+        }
+    });
+    (src, dst)
+}
+
+fn bench_mesh(c: &mut Criterion) {
+    let src = plate(0.0);
+    let (from, to) = mesh_pair();
+    let sampler = Sampler::new(
+        src.view(),
+        PixelScale::UNIT,
+        Filter::Bilinear,
+        EdgeMode::Clamp,
+        true,
+    );
+    let mut g = c.benchmark_group("mesh_1080p_rgba_f32_20x20");
+    g.sample_size(10).measurement_time(Duration::from_secs(6));
+    // A sequence render reuses its output plane; a fresh one costs ~13 ms
+    // more here (first touch of 33 MB).
+    let mut plane = mesh::two_pass(&sampler, &from, &to, frame(), PixelScale::UNIT);
+    g.bench_function("two_pass", |b| {
+        b.iter(|| mesh::two_pass_into(&sampler, &from, &to, PixelScale::UNIT, &mut plane))
+    });
+    g.bench_function("two_pass_fresh_output", |b| {
+        b.iter(|| {
+            black_box(mesh::two_pass(
+                &sampler,
+                &from,
+                &to,
+                frame(),
+                PixelScale::UNIT,
+            ))
+        })
+    });
+    let warp = MeshWarp::new(&from, &to);
+    g.bench_function("one_pass_map", |b| {
+        b.iter(|| black_box(warp.map_window(frame(), PixelScale::UNIT)))
+    });
+    g.finish();
+}
+
+fn bench_triangles(c: &mut Criterion) {
+    let features: Vec<Feature> = line_pairs(100, 7)
+        .into_iter()
+        .flat_map(|l| {
+            [
+                Feature::point(l.src.0, l.dst.0),
+                Feature::point(l.src.1, l.dst.1),
+            ]
+        })
+        .collect();
+    let full = RectD::new(0.0, 0.0, W as f64, H as f64);
+    let mut g = c.benchmark_group("triangles_1080p_200_points");
+    g.sample_size(20);
+    g.bench_function("triangulate_and_map", |b| {
+        b.iter(|| {
+            let w = TriangleWarp::toward(&features, Side::A, 0.5, 20, full).unwrap();
+            black_box(w.map_window(frame(), PixelScale::UNIT))
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_field,
+    bench_resample,
+    bench_morph,
+    bench_mesh,
+    bench_triangles
+);
 criterion_main!(benches);

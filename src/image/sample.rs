@@ -135,6 +135,31 @@ impl<'a, T: Sample> Sampler<'a, T> {
         self.alpha_weighted
     }
 
+    /// Row `j` of the source (inside the bounds) as floats in `out`, one
+    /// pixel per entry in the sampler's layout; colour multiplied by alpha
+    /// when the sampler weights by alpha (straight RGBA), so the row can be
+    /// filtered linearly and divided back afterwards.
+    pub fn load_row(&self, j: i32, out: &mut Vec<[f32; 4]>) {
+        let b = self.view.bounds();
+        self.load_span(j, b.x1, b.width(), out);
+    }
+
+    /// [`Sampler::load_row`] for the `len` pixels from column `i` (inside
+    /// the bounds).
+    pub fn load_span(&self, j: i32, i: i32, len: usize, out: &mut Vec<[f32; 4]>) {
+        let c = self.view.channels();
+        let start = (i - self.view.bounds().x1) as usize * c;
+        let row = &self.view.row(j)[start..start + len * c];
+        out.clear();
+        match (self.view.channels(), self.alpha_weighted) {
+            (4, true) => load::<T, 4, true>(row, out),
+            (4, false) => load::<T, 4, false>(row, out),
+            (3, _) => load::<T, 3, false>(row, out),
+            (2, _) => load::<T, 2, false>(row, out),
+            _ => load::<T, 1, false>(row, out),
+        }
+    }
+
     /// The source pixel `(i, j)` itself, if inside the bounds.
     #[inline]
     pub fn pixel(&self, i: i32, j: i32, out: &mut [f32; 4]) -> bool {
@@ -331,6 +356,22 @@ fn add<T: Sample, const C: usize, const AW: bool>(acc: &mut [f32; 4], px: &[T], 
             acc[c] += w * px[c].to_f32();
         }
     }
+}
+
+/// Converts a row of `C`-channel samples to float pixels (alpha-weighted
+/// colour when `AW`), one layout per instance so the loop vectorises.
+fn load<T: Sample, const C: usize, const AW: bool>(row: &[T], out: &mut Vec<[f32; 4]>) {
+    out.extend(row.chunks_exact(C).map(|px| {
+        let mut v = [0f32; 4];
+        for c in 0..C {
+            v[c] = px[c].to_f32();
+        }
+        if AW {
+            [v[0] * v[3], v[1] * v[3], v[2] * v[3], v[3]]
+        } else {
+            v
+        }
+    }));
 }
 
 /// Alpha-weighted sums back to straight colour: `acc[3] = Σ w a`,

@@ -13,42 +13,10 @@
 
 use crate::image::EdgeMode;
 
-/// Inverts a forward map sampled at the input pixel edges (`forward[i]` is
-/// where input edge `i` lands) at the output edges `x0 + k`, `k = 0..out.len()`.
-/// Folds (decreasing stretches) are skipped, as the listing's walk does; past
-/// both ends the map continues with slope one.
-pub fn invert(forward: &[f64], x0: f64, out: &mut [f64]) {
-    let n = forward.len() - 1;
-    let (first, last) = (forward[0], forward[n]);
-    let mut i = 0;
-    for (k, u) in out.iter_mut().enumerate() {
-        let x = x0 + k as f64;
-        if x <= first {
-            *u = x - first;
-            continue;
-        }
-        if x >= last {
-            *u = n as f64 + (x - last);
-            continue;
-        }
-        // `x` grows with k, so the segment holding it only moves right.
-        while i < n && forward[i + 1] <= x {
-            i += 1;
-        }
-        // forward[i] <= x < forward[i + 1] unless an earlier fold overshot.
-        let (a, b) = (forward[i], forward[i + 1]);
-        *u = if b > a {
-            i as f64 + ((x - a) / (b - a)).clamp(0.0, 1.0)
-        } else {
-            i as f64
-        };
-    }
-}
-
 /// The value of the output pixel whose preimage is `[u0, u1]` (in either
 /// order), reading input pixel `i` of `n` through `read` and the edge mode
 /// beyond them.
-#[inline]
+#[inline(always)]
 pub fn sample(
     u0: f64,
     u1: f64,
@@ -57,16 +25,50 @@ pub fn sample(
     read: impl Fn(usize) -> [f32; 4],
 ) -> [f32; 4] {
     let (lo, hi) = if u0 <= u1 { (u0, u1) } else { (u1, u0) };
-    let centre = 0.5 * (lo + hi);
-    let half = (0.5 * (hi - lo)).max(0.5);
-    let (a, b) = (centre - half, centre + half);
+    let len = (hi - lo).max(1.0);
+    let a = 0.5 * (lo + hi - len);
+    let first = a.floor();
+    if first >= 0.0 && first + 3.0 <= n as f64 && len <= 2.0 {
+        // The common case, without branches: a box of width 1 to 2 inside
+        // the line covers at most three pixels (the third may weigh 0).
+        let i0 = first as usize;
+        let (fa, l) = ((a - first) as f32, len as f32);
+        let inv = 1.0 / l;
+        // Weights of the second and third pixel over the box; the first takes
+        // the rest, written as offsets from it so flat data stays exact.
+        let (w1, w2) = ((l + fa - 1.0).min(1.0) * inv, (l + fa - 2.0).max(0.0) * inv);
+        let (p, q, r) = (read(i0), read(i0 + 1), read(i0 + 2));
+        return std::array::from_fn(|c| p[c] + w1 * (q[c] - p[c]) + w2 * (r[c] - p[c]));
+    }
+    let b = a + len;
     let mut acc = [0f32; 4];
     if !(a.is_finite() && b.is_finite()) {
         return acc;
     }
-    // A preimage longer than the whole line repeats it (mirror) or its end
-    // (clamp); clip the loop to a bounded number of taps.
-    let first = a.floor();
+    let inv = (1.0 / len) as f32;
+    let last = b.ceil() - 1.0;
+    if first >= 0.0 && last < n as f64 {
+        // Inside the line: partial end pixels, whole ones between.
+        let (i0, i1) = (first as usize, last as usize);
+        if i0 == i1 {
+            return read(i0);
+        }
+        let (w0, w1) = ((first + 1.0 - a) as f32, (b - last) as f32);
+        let (p, q) = (read(i0), read(i1));
+        for c in 0..4 {
+            acc[c] = w0 * p[c] + w1 * q[c];
+        }
+        for i in i0 + 1..i1 {
+            let v = read(i);
+            for c in 0..4 {
+                acc[c] += v[c];
+            }
+        }
+        return acc.map(|v| v * inv);
+    }
+    // Across an end of the line: each tap through the edge mode. A preimage
+    // longer than the whole line repeats it (mirror) or its end (clamp), so
+    // the loop is bounded.
     let count = ((b - first).ceil() as i64).clamp(1, 4 * n as i64 + 4);
     for k in 0..count {
         let i = first + k as f64;
@@ -84,7 +86,6 @@ pub fn sample(
             }
         }
     }
-    let inv = (1.0 / (b - a)) as f32;
     acc.map(|v| v * inv)
 }
 
@@ -101,19 +102,26 @@ mod tests {
             .collect()
     }
 
-    fn resample(src: &[[f32; 4]], forward: &[f64], m: usize, edge: EdgeMode) -> Vec<[f32; 4]> {
-        let mut u = vec![0.0; m + 1];
-        invert(forward, 0.0, &mut u);
+    /// Output pixel `k` has the preimage `[pre(k), pre(k + 1)]`.
+    fn resample(
+        src: &[[f32; 4]],
+        m: usize,
+        edge: EdgeMode,
+        pre: impl Fn(f64) -> f64,
+    ) -> Vec<[f32; 4]> {
         (0..m)
-            .map(|k| sample(u[k], u[k + 1], src.len(), edge, |i| src[i]))
+            .map(|k| {
+                sample(pre(k as f64), pre(k as f64 + 1.0), src.len(), edge, |i| {
+                    src[i]
+                })
+            })
             .collect()
     }
 
     #[test]
     fn identity_copies_exactly() {
         let src = line(50);
-        let forward: Vec<f64> = (0..=50).map(|i| i as f64).collect();
-        assert_eq!(resample(&src, &forward, 50, EdgeMode::Clamp), src);
+        assert_eq!(resample(&src, 50, EdgeMode::Clamp, |x| x), src);
     }
 
     #[test]
@@ -122,24 +130,17 @@ mod tests {
         // non-uniform squeeze: the sums (means times lengths) must agree.
         let src = line(90);
         let total: f64 = src.iter().map(|p| p[0] as f64).sum();
-        let uniform: Vec<f64> = (0..=90).map(|i| i as f64 / 2.5).collect();
-        let out = resample(&src, &uniform, 36, EdgeMode::Clamp);
+        let out = resample(&src, 36, EdgeMode::Clamp, |x| x * 2.5);
         let sum: f64 = out.iter().map(|p| p[0] as f64 * 2.5).sum();
         assert!((sum - total).abs() < 1e-4, "{sum} vs {total}");
 
-        let curved: Vec<f64> = (0..=90)
-            .map(|i| {
-                let u = i as f64 / 90.0;
-                30.0 * (u + 0.3 * u * (1.0 - u))
-            })
-            .collect();
-        let out = resample(&src, &curved, 30, EdgeMode::Clamp);
-        let mut u = vec![0.0; 31];
-        invert(&curved, 0.0, &mut u);
+        // Preimages from 2× to 4× long: every output pixel a box of 2+ pixels.
+        let curved = |x: f64| 90.0 * (x / 30.0 + 0.5 * (x / 30.0) * (1.0 - x / 30.0));
+        let out = resample(&src, 30, EdgeMode::Clamp, curved);
         let sum: f64 = out
             .iter()
             .enumerate()
-            .map(|(k, p)| p[0] as f64 * (u[k + 1] - u[k]))
+            .map(|(k, p)| p[0] as f64 * (curved(k as f64 + 1.0) - curved(k as f64)))
             .sum();
         assert!((sum - total).abs() < 1e-3, "{sum} vs {total}");
     }
@@ -148,8 +149,7 @@ mod tests {
     fn magnification_interpolates_linearly_between_centres() {
         let src = line(20);
         // Magnify by 4: output pixel k's preimage centre is (k + 0.5) / 4.
-        let forward: Vec<f64> = (0..=20).map(|i| i as f64 * 4.0).collect();
-        let out = resample(&src, &forward, 80, EdgeMode::Clamp);
+        let out = resample(&src, 80, EdgeMode::Clamp, |x| x / 4.0);
         for (k, px) in out.iter().enumerate() {
             let c = (k as f64 + 0.5) / 4.0 - 0.5; // continuous index, centres at integers
             let i0 = c.floor().clamp(0.0, 19.0) as usize;
@@ -167,12 +167,14 @@ mod tests {
     #[test]
     fn edge_modes_beyond_the_line() {
         let src = vec![[1.0f32, 2.0, 3.0, 1.0]; 4];
-        // Shift right by 2: the first two output pixels read before the line.
-        let forward: Vec<f64> = (0..=4).map(|i| i as f64 + 2.0).collect();
-        let clamp = resample(&src, &forward, 4, EdgeMode::Clamp);
-        let black = resample(&src, &forward, 4, EdgeMode::Black);
+        // Shifted right by 2: the first two output pixels read before the line.
+        let clamp = resample(&src, 4, EdgeMode::Clamp, |x| x - 2.0);
+        let black = resample(&src, 4, EdgeMode::Black, |x| x - 2.0);
         assert_eq!(clamp[0], [1.0, 2.0, 3.0, 1.0]);
         assert_eq!(black[0], [0.0; 4]);
         assert_eq!(black[3], [1.0, 2.0, 3.0, 1.0]);
+        // Reversed preimages (a fold) read the same pixels.
+        let folded = sample(3.0, 2.0, 4, EdgeMode::Clamp, |i| src[i]);
+        assert_eq!(folded, [1.0, 2.0, 3.0, 1.0]);
     }
 }

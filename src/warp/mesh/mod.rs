@@ -16,7 +16,7 @@ pub mod spline;
 mod two_pass;
 
 pub use patch::MeshWarp;
-pub use two_pass::two_pass;
+pub use two_pass::{two_pass, two_pass_into};
 
 use crate::error::{Error, Result};
 use crate::features::Side;

@@ -152,8 +152,8 @@ fn nodes_land_on_their_destinations() {
 /// Where the two evaluations may differ on a smooth mesh: the two-pass
 /// splines run through the nodes' actual coordinates, the patches through
 /// their indices, and the second pass filters columns of the first. Measured
-/// worst case for this mesh (displacements up to 5 px): 0.087 px.
-const TWO_VS_ONE_PASS_PX: f64 = 0.15;
+/// worst case for this mesh (displacements up to 5 px): 0.14 px.
+const TWO_VS_ONE_PASS_PX: f64 = 0.2;
 
 #[test]
 fn two_pass_and_one_pass_agree_on_smooth_meshes() {
