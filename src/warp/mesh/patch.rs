@@ -173,6 +173,11 @@ impl Surface {
             }
             s = (s + ds).clamp(-1.0, hi_s);
             r = (r + dr).clamp(-1.0, hi_r);
+            // Newton converges quadratically: after a step this small the
+            // error left is far below the tolerance, no need to look again.
+            if m < 1e-6 {
+                return Some((s, r));
+            }
         }
         None
     }
@@ -278,10 +283,20 @@ impl Warp for MeshWarp {
         if w > 0 {
             pos.par_chunks_mut(w).enumerate().for_each(|(row, out)| {
                 let j = window.y1 + row as i32;
-                let mut guess = None;
+                // Start each pixel where the last two solutions point: one
+                // Newton step usually lands within tolerance.
+                let (mut prev, mut before): (Option<(f64, f64)>, Option<(f64, f64)>) = (None, None);
                 for (k, o) in out.iter_mut().enumerate() {
+                    let guess = match (prev, before) {
+                        (Some(a), Some(b)) => Some((2.0 * a.0 - b.0, 2.0 * a.1 - b.1)),
+                        _ => prev,
+                    };
                     let (q, g) = self.locate(scale.pixel_centre(window.x1 + k as i32, j), guess);
-                    guess = g.or(guess);
+                    if g.is_some() {
+                        (before, prev) = (prev, g);
+                    } else {
+                        (before, prev) = (None, None);
+                    }
                     *o = [q.x as f32, q.y as f32];
                 }
             });
