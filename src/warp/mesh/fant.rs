@@ -37,7 +37,12 @@ pub fn sample(
         // Weights of the second and third pixel over the box; the first takes
         // the rest, written as offsets from it so flat data stays exact.
         let (w1, w2) = ((l + fa - 1.0).min(1.0) * inv, (l + fa - 2.0).max(0.0) * inv);
-        let (p, q, r) = (read(i0), read(i0 + 1), read(i0 + 2));
+        let (p, q) = (read(i0), read(i0 + 1));
+        if w2 == 0.0 {
+            // Magnifying or the identity: two taps, linear interpolation.
+            return std::array::from_fn(|c| p[c] + w1 * (q[c] - p[c]));
+        }
+        let r = read(i0 + 2);
         return std::array::from_fn(|c| p[c] + w1 * (q[c] - p[c]) + w2 * (r[c] - p[c]));
     }
     let b = a + len;

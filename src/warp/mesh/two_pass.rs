@@ -99,10 +99,10 @@ pub fn two_pass_into<S: Sample>(
             let k0 = index * STRIP;
             let w = out[0].len();
             // The strip's column maps: preimages of the output row edges in
-            // intermediate rows, column after column.
+            // intermediate rows, stored row by row for the second pass.
             strip.pre.clear();
             strip.pre.resize(w * (ho + 1), 0.0);
-            for (c, col) in strip.pre.chunks_exact_mut(ho + 1).enumerate() {
+            for c in 0..w {
                 let knots = (k0 + c) * rows..(k0 + c + 1) * rows;
                 let buf = &mut strip.buf;
                 buf.stretch(
@@ -111,8 +111,8 @@ pub fn two_pass_into<S: Sample>(
                     &out_y_edges,
                     b.y1 as f64,
                 );
-                for (o, v) in col.iter_mut().zip(&buf.pre) {
-                    *o = *v as f32;
+                for (l, v) in buf.pre.iter().enumerate() {
+                    strip.pre[l * w + c] = *v as f32;
                 }
             }
             let (r0, r1) = rows_read(&strip.pre, h, edge);
@@ -155,9 +155,9 @@ pub fn two_pass_into<S: Sample>(
             let (inter, pre) = (&strip.inter, &strip.pre);
             let last = r1 - r0 - 1;
             for (l, row) in out.iter_mut().enumerate() {
+                let (top, bottom) = (&pre[l * w..(l + 1) * w], &pre[(l + 1) * w..(l + 2) * w]);
                 for (c, o) in row.iter_mut().enumerate() {
-                    let at = c * (ho + 1) + l;
-                    let px = fant::sample(pre[at] as f64, pre[at + 1] as f64, h, edge, |i| {
+                    let px = fant::sample(top[c] as f64, bottom[c] as f64, h, edge, |i| {
                         inter[i.saturating_sub(r0).min(last) * w + c]
                     });
                     *o = if premultiply && px[3] != 0.0 {
@@ -183,7 +183,7 @@ fn span(values: &[f64]) -> (f64, f64) {
 struct Strip {
     /// First-pass pixels the strip reads, row by row.
     inter: Vec<[f32; 4]>,
-    /// The strip's column maps, column by column.
+    /// The strip's column maps, row by row of the output.
     pre: Vec<f32>,
     buf: Buffers,
 }
