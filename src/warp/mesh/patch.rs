@@ -24,6 +24,9 @@ const M: [[f64; 4]; 4] = [
 const TOLERANCE: f64 = 1e-7;
 const MAX_STEPS: usize = 16;
 
+/// Surface parameters `(s, r)`: column and row index, fractional.
+type Params = (f64, f64);
+
 /// One mesh as bicubic patches in power form, one per cell.
 #[derive(Debug, Clone)]
 struct Surface {
@@ -285,7 +288,7 @@ impl Warp for MeshWarp {
                 let j = window.y1 + row as i32;
                 // Start each pixel where the last two solutions point: one
                 // Newton step usually lands within tolerance.
-                let (mut prev, mut before): (Option<(f64, f64)>, Option<(f64, f64)>) = (None, None);
+                let (mut prev, mut before): (Option<Params>, Option<Params>) = (None, None);
                 for (k, o) in out.iter_mut().enumerate() {
                     let guess = match (prev, before) {
                         (Some(a), Some(b)) => Some((2.0 * a.0 - b.0, 2.0 * a.1 - b.1)),
