@@ -18,6 +18,19 @@ use crate::geom::RectI;
 pub trait Sample: Copy + Send + Sync + Default + PartialEq + std::fmt::Debug + 'static {
     fn to_f32(self) -> f32;
     fn from_f32(v: f32) -> Self;
+
+    /// The first eight samples of `s` as floats.
+    #[inline(always)]
+    fn load8(s: &[Self]) -> wide::f32x8 {
+        wide::f32x8::new(std::array::from_fn(|q| s[q].to_f32()))
+    }
+
+    /// The samples themselves when they already are floats, so float images
+    /// can be written without a conversion pass.
+    #[inline(always)]
+    fn as_f32_mut(_s: &mut [Self]) -> Option<&mut [f32]> {
+        None
+    }
 }
 
 impl Sample for f32 {
@@ -28,6 +41,15 @@ impl Sample for f32 {
     #[inline(always)]
     fn from_f32(v: f32) -> Self {
         v
+    }
+    #[inline(always)]
+    fn load8(s: &[f32]) -> wide::f32x8 {
+        let v: [f32; 8] = s[..8].try_into().expect("eight samples");
+        wide::f32x8::from(v)
+    }
+    #[inline(always)]
+    fn as_f32_mut(s: &mut [f32]) -> Option<&mut [f32]> {
+        Some(s)
     }
 }
 

@@ -46,6 +46,14 @@ pub fn fill_rows<D: Sample>(
     let b = dst.bounds;
     let dc = dst.channels;
     let work = |(scratch, spare): &mut Buffers, (j, row): (i32, &mut [D])| {
+        // Float RGBA in and out: compute straight into the output row.
+        if src_channels == 4 && dc == 4 {
+            if let Some(floats) = D::as_f32_mut(row) {
+                let (pixels, _) = floats.as_chunks_mut::<4>();
+                f(j, b.x1, pixels, spare);
+                return;
+            }
+        }
         scratch.clear();
         scratch.resize(b.width(), [0.0; 4]);
         f(j, b.x1, scratch, spare);

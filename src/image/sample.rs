@@ -316,19 +316,13 @@ impl<'a, T: Sample> Sampler<'a, T> {
     fn bilinear_rgba<const AW: bool>(&self, i0: i32, j0: i32, tx: f32, ty: f32) -> [f32; 4] {
         let k = (i0 - self.view.bounds().x1) as usize * 4;
         let load = |j: i32| {
-            let row = &self.view.row(j)[k..k + 8];
-            let v: [f32; 8] = std::array::from_fn(|q| row[q].to_f32());
+            let v = T::load8(&self.view.row(j)[k..k + 8]);
             if AW {
                 // Colour weighted by its own alpha; alpha itself stays.
-                f32x8::new(std::array::from_fn(|q| {
-                    if q % 4 == 3 {
-                        v[q]
-                    } else {
-                        v[q] * v[q - q % 4 + 3]
-                    }
-                }))
+                let a = v.to_array();
+                v * f32x8::new([a[3], a[3], a[3], 1.0, a[7], a[7], a[7], 1.0])
             } else {
-                f32x8::new(v)
+                v
             }
         };
         let (below, above) = (load(j0), load(j0 + 1));
