@@ -44,8 +44,7 @@ impl Sample for f32 {
     }
     #[inline(always)]
     fn load8(s: &[f32]) -> wide::f32x8 {
-        let v: [f32; 8] = s[..8].try_into().expect("eight samples");
-        wide::f32x8::from(v)
+        wide::f32x8::new(*s.first_chunk::<8>().expect("eight samples"))
     }
     #[inline(always)]
     fn as_f32_mut(s: &mut [f32]) -> Option<&mut [f32]> {
