@@ -80,6 +80,33 @@ impl Lines {
         l
     }
 
+    /// The lines at `indices` of `self`, into `out` (reusing its buffers):
+    /// a block's near or far set without recomputing lengths and powers.
+    pub fn select_into(&self, indices: &[usize], out: &mut Lines) {
+        for (dst, src) in [
+            (&mut out.px, &self.px),
+            (&mut out.py, &self.py),
+            (&mut out.qx, &self.qx),
+            (&mut out.qy, &self.qy),
+            (&mut out.dx, &self.dx),
+            (&mut out.dy, &self.dy),
+            (&mut out.inv_len2, &self.inv_len2),
+            (&mut out.inv_len, &self.inv_len),
+            (&mut out.spx, &self.spx),
+            (&mut out.spy, &self.spy),
+            (&mut out.ex, &self.ex),
+            (&mut out.ey, &self.ey),
+            (&mut out.nx, &self.nx),
+            (&mut out.ny, &self.ny),
+            (&mut out.len_p, &self.len_p),
+        ] {
+            dst.clear();
+            dst.extend(indices.iter().map(|&i| src[i]));
+        }
+        out.a = self.a;
+        out.exponent = self.exponent;
+    }
+
     /// Positions `(x, y) + Σ w·(X′ − X) / Σ w` over these lines.
     pub fn map_points(&self, xs: &[f32], ys: &[f32], out_x: &mut [f32], out_y: &mut [f32]) {
         let zero = Sums::default();

@@ -18,7 +18,7 @@ use crate::geom::{PixelScale, RectI, Vec2};
 use crate::warp::WarpMap;
 
 /// Side of a block, pixels.
-const BLOCK: i32 = 32;
+const BLOCK: i32 = 48;
 /// Spacing of the far-field grid, pixels.
 const GRID: i32 = 4;
 /// Pixel offsets within a grid cell, as fractions of it.
@@ -95,7 +95,19 @@ struct Scratch {
     oy: Vec<f32>,
     /// Far sums along a row, one vector per component, padded to whole lanes.
     far: [Vec<f32>; 3],
-    nodes: Vec<[f32; 3]>,
+    /// Far sums interpolated along each grid row: `[(row * 3 + m) * stride + k]`.
+    across: Vec<f32>,
+    sets: Sets,
+}
+
+/// A block's near and far lines (indices into the warp's lines, and the
+/// lines themselves), reused from block to block.
+#[derive(Default)]
+struct Sets {
+    near_idx: Vec<usize>,
+    far_idx: Vec<usize>,
+    near: Lines,
+    far: Lines,
 }
 
 impl Block<'_> {
@@ -105,22 +117,27 @@ impl Block<'_> {
             Vec2::new(b.x1 as f64 + 0.5, b.y1 as f64 + 0.5),
             Vec2::new(b.x2 as f64 - 0.5, b.y2 as f64 - 0.5),
         );
-        let (mut near, mut far) = (Vec::new(), Vec::new());
-        for (pair, &(p, q)) in self.warp.pairs.iter().zip(segments) {
-            if segment_box_distance(p, q, lo, hi) < NEAR {
-                near.push(*pair);
+        let mut sets = std::mem::take(&mut self.scratch.sets);
+        sets.near_idx.clear();
+        sets.far_idx.clear();
+        for (k, &(p, q)) in segments.iter().enumerate() {
+            if is_near(p, q, lo, hi) {
+                sets.near_idx.push(k);
             } else {
-                far.push(*pair);
+                sets.far_idx.push(k);
             }
         }
-        if far.is_empty() {
+        if sets.far_idx.is_empty() {
+            self.scratch.sets = sets;
             self.exact();
             return;
         }
-        let far = Lines::new(&far, &self.warp.weight);
-        let near = Lines::new(&near, &self.warp.weight);
-        let grid = self.far_grid(&far);
-        self.interpolated(&near, &grid);
+        let all = &self.warp.kernel;
+        all.select_into(&sets.far_idx, &mut sets.far);
+        all.select_into(&sets.near_idx, &mut sets.near);
+        let grid = self.far_grid(&sets.far);
+        self.interpolated(&sets.near, &grid);
+        self.scratch.sets = sets;
         if !self.checks_pass(tol) {
             self.exact();
         }
@@ -185,17 +202,39 @@ impl Block<'_> {
             v.clear();
             v.resize(n + 8, 0.0);
         }
-        sc.nodes.resize(grid.map_or(0, |g| g.nx), [0.0; 3]);
-        for j in b.y1..b.y2 {
-            sc.ys.fill(self.centre(b.x1, j).1);
-            if let Some(grid) = grid {
-                grid.row(j - b.y1, &mut sc.nodes);
-                for (m, far) in sc.far.iter_mut().enumerate() {
-                    for (cell, w) in far.chunks_exact_mut(GRID as usize).zip(sc.nodes.windows(2)) {
+        // The far sums along each grid row, interpolated across once per
+        // block; each pixel row then blends the two grid rows around it, a
+        // loop over whole rows that vectorises.
+        let stride = n + 8;
+        if let Some(grid) = grid {
+            let ny = grid.sums.len() / grid.nx;
+            sc.across.clear();
+            sc.across.resize(ny * 3 * stride, 0.0);
+            for (c, nodes) in grid.sums.chunks_exact(grid.nx).enumerate() {
+                for m in 0..3 {
+                    let row = &mut sc.across[(c * 3 + m) * stride..(c * 3 + m + 1) * stride];
+                    for (cell, w) in row.chunks_exact_mut(GRID as usize).zip(nodes.windows(2)) {
                         let (a, d) = (w[0][m], w[1][m] - w[0][m]);
                         for (o, f) in cell.iter_mut().zip(FRACTIONS) {
                             *o = a + d * f;
                         }
+                    }
+                }
+            }
+        }
+        for j in b.y1..b.y2 {
+            sc.ys.fill(self.centre(b.x1, j).1);
+            if grid.is_some() {
+                let dy = (j - b.y1) as usize;
+                let (c, f) = (
+                    dy / GRID as usize,
+                    (dy % GRID as usize) as f32 / GRID as f32,
+                );
+                for (m, far) in sc.far.iter_mut().enumerate() {
+                    let lo = &sc.across[(c * 3 + m) * stride..(c * 3 + m + 1) * stride];
+                    let hi = &sc.across[((c + 1) * 3 + m) * stride..((c + 1) * 3 + m + 1) * stride];
+                    for ((o, a), b) in far.iter_mut().zip(lo).zip(hi) {
+                        *o = a + (b - a) * f;
                     }
                 }
             }
@@ -246,16 +285,17 @@ struct Grid {
     sums: Vec<[f32; 3]>,
 }
 
-impl Grid {
-    /// The nodes of pixel row `dy` (from the block's bottom), interpolated
-    /// between the grid rows around it.
-    fn row(&self, dy: i32, out: &mut [[f32; 3]]) {
-        let (c, f) = ((dy / GRID) as usize, (dy % GRID) as f32 / GRID as f32);
-        let (bottom, top) = (&self.sums[c * self.nx..], &self.sums[(c + 1) * self.nx..]);
-        for (o, (b, t)) in out.iter_mut().zip(bottom.iter().zip(top)) {
-            *o = std::array::from_fn(|m| b[m] + (t[m] - b[m]) * f);
-        }
+/// Whether segment `p→q` comes within [`NEAR`] of the box `[lo, hi]`. Most
+/// lines are far from most blocks, and their bounding boxes say so without
+/// the exact distance.
+#[inline]
+fn is_near(p: Vec2, q: Vec2, lo: Vec2, hi: Vec2) -> bool {
+    let gap_x = (lo.x - p.x.max(q.x)).max(p.x.min(q.x) - hi.x);
+    let gap_y = (lo.y - p.y.max(q.y)).max(p.y.min(q.y) - hi.y);
+    if gap_x >= NEAR || gap_y >= NEAR {
+        return false;
     }
+    segment_box_distance(p, q, lo, hi) < NEAR
 }
 
 /// Distance from segment `p→q` to the axis-aligned box `[lo, hi]` (0 when
