@@ -1,17 +1,20 @@
 //! The built bundle loaded through its C ABI (never linked): plugin list,
 //! descriptors, params, and renders held against the core engine's output for
 //! the same inputs at render scale 1 and 0.5, every depth and component kind,
-//! shifted image bounds, negative row bytes, and concurrent tiles.
+//! shifted image bounds, negative row bytes, and concurrent tiles — for the
+//! field, mesh and triangle methods.
 
 use std::sync::{Arc, OnceLock};
 
 mod common;
 
 use morphfx::features::{Feature, FeatureKind, Side};
-use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp};
+use morphfx::warp::mesh::{two_pass, Mesh, MeshPair};
+use morphfx::warp::triangles::TriangleWarp;
 use morphfx::warp::Warp;
 use morphfx_harness::host::{Bundle, Frame, FrameSource, OutputSpec};
 use openfx::sys::generic::core::*;
@@ -64,7 +67,79 @@ fn plate(bounds: RectI, channels: usize, seed: f32) -> Image {
     })
 }
 
+/// The warp generator a case renders with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Method {
+    /// Line slots keyed on the node.
+    Field,
+    /// The scene text's mesh, two-pass.
+    Mesh,
+    /// The scene text's features, triangulated.
+    Triangles,
+}
+
+/// A 4 × 4 mesh on `bounds` (canonical at full resolution), its inner
+/// nodes moved on B.
+fn mesh_pair(bounds: RectI) -> MeshPair {
+    let (x1, y1, x2, y2) = (
+        bounds.x1 as f64,
+        bounds.y1 as f64,
+        bounds.x2 as f64,
+        bounds.y2 as f64,
+    );
+    let a = Mesh::regular(4, 4, x1, y1, x2, y2).unwrap();
+    let b = a.map_nodes(|r, c, p| {
+        let inner = (1..3).contains(&r) && (1..3).contains(&c);
+        if inner {
+            p + Vec2::new(3.0 * (c as f64 - 1.5), 2.5 * (r as f64 - 1.2))
+        } else {
+            p
+        }
+    });
+    MeshPair::new(a, b).unwrap()
+}
+
+fn points_json(points: &[Vec2]) -> String {
+    let p: Vec<String> = points
+        .iter()
+        .map(|p| format!("[{}, {}]", p.x, p.y))
+        .collect();
+    format!("[{}]", p.join(", "))
+}
+
+/// The scene text a case puts on the node.
+fn scene_text(case: &Case) -> String {
+    match case.method {
+        Method::Field => String::new(),
+        Method::Mesh => {
+            let pair = mesh_pair(case.bounds);
+            format!(
+                r#"{{"method": "mesh", "mesh": {{"rows": 4, "cols": 4, "a": {}, "b": {}}}}}"#,
+                points_json(pair.a.nodes()),
+                points_json(pair.b.nodes())
+            )
+        }
+        Method::Triangles => {
+            let f: Vec<String> = features()
+                .iter()
+                .map(|f| {
+                    format!(
+                        r#"{{"type": "line", "a": {}, "b": {}}}"#,
+                        points_json(&f.a),
+                        points_json(&f.b)
+                    )
+                })
+                .collect();
+            format!(
+                r#"{{"method": "triangles", "features": [{}]}}"#,
+                f.join(", ")
+            )
+        }
+    }
+}
+
 struct Case {
+    method: Method,
     depth: &'static str,
     channels: usize,
     scale: f64,
@@ -76,6 +151,7 @@ struct Case {
 impl Default for Case {
     fn default() -> Self {
         Case {
+            method: Method::Field,
             depth: "OfxBitDepthFloat",
             channels: 4,
             scale: 1.0,
@@ -111,7 +187,14 @@ fn render_morph(case: &Case) -> (Image, Image, Image) {
     inst.set_project(case.bounds.width() as f64, case.bounds.height() as f64);
     inst.set_double("progress", &[T], None).unwrap();
     inst.set_choice("evaluation", "exact").unwrap();
-    let ls = lines();
+    if case.method != Method::Field {
+        inst.set_string("scene_text", &scene_text(case)).unwrap();
+    }
+    let ls = if case.method == Method::Field {
+        lines()
+    } else {
+        Vec::new()
+    };
     inst.set_int("line_count", ls.len() as i32).unwrap();
     for (k, [a0, a1, b0, b1]) in ls.into_iter().enumerate() {
         let k = k + 1;
@@ -152,11 +235,35 @@ fn expected(case: &Case, a: &Image, b: &Image) -> Image {
     let f = features();
     let scale = PixelScale::new(case.scale, case.scale, 1.0);
     let full = a.bounds;
-    let ma = FieldWarp::toward(&f, Side::A, T, &settings).map_window(full, scale);
-    let mb = FieldWarp::toward(&f, Side::B, T, &settings).map_window(full, scale);
     let sa = Sampler::new(a.view(), scale, Filter::Bilinear, EdgeMode::Clamp, true);
     let sb = Sampler::new(b.view(), scale, Filter::Bilinear, EdgeMode::Clamp, true);
     let mut out = Image::new(full, case.channels);
+    let frame = RectD::new(
+        case.bounds.x1 as f64,
+        case.bounds.y1 as f64,
+        case.bounds.x2 as f64,
+        case.bounds.y2 as f64,
+    );
+    let map = |side: Side| match case.method {
+        Method::Triangles => TriangleWarp::toward(&f, side, T, 20, frame)
+            .unwrap()
+            .map_window(full, scale),
+        _ => FieldWarp::toward(&f, side, T, &settings).map_window(full, scale),
+    };
+    if case.method == Method::Mesh {
+        let pair = mesh_pair(case.bounds);
+        let to = pair.at(T);
+        let pa = two_pass(&sa, &pair.a, &to, full, scale);
+        let pb = two_pass(&sb, &pair.b, &to, full, scale);
+        dissolve::<f32, f32>(
+            Warped::Pixels(&pa),
+            Warped::Pixels(&pb),
+            T,
+            out.view_mut().rows(),
+        );
+        return out;
+    }
+    let (ma, mb) = (map(Side::A), map(Side::B));
     dissolve(
         Warped::Map(&sa, &ma),
         Warped::Map(&sb, &mb),
@@ -191,7 +298,8 @@ fn check(case: Case) {
     let worst = worst_difference(&got, &want);
     assert!(
         worst <= tolerance(case.depth),
-        "{} ×{} channels, scale {}, bounds {:?}, top-down {}: off by {worst}",
+        "{:?} {} ×{} channels, scale {}, bounds {:?}, top-down {}: off by {worst}",
+        case.method,
         case.depth,
         case.channels,
         case.scale,
@@ -367,6 +475,47 @@ fn eight_concurrent_tiles_equal_the_serial_render() {
         assert_eq!(
             serial, tiled,
             "{depth}: tiles differ from the serial render"
+        );
+    }
+}
+
+#[test]
+fn mesh_and_triangle_renders_match_the_core_at_every_depth_scale_and_layout() {
+    for method in [Method::Mesh, Method::Triangles] {
+        for depth in DEPTHS {
+            for scale in [1.0, 0.5] {
+                check(Case {
+                    method,
+                    depth,
+                    scale,
+                    ..Case::default()
+                });
+            }
+            check(Case {
+                method,
+                depth,
+                channels: 3,
+                bounds: RectI::new(10, 7, 74, 55),
+                top_down: true,
+                ..Case::default()
+            });
+        }
+        // Tiles of one frame agree with the whole frame (the two-pass warp
+        // is made per render window).
+        let whole = render_morph(&Case {
+            method,
+            ..Case::default()
+        })
+        .0;
+        let tiled = render_morph(&Case {
+            method,
+            tiles: 8,
+            ..Case::default()
+        })
+        .0;
+        assert_eq!(
+            whole, tiled,
+            "{method:?}: tiles differ from the whole frame"
         );
     }
 }
