@@ -15,6 +15,7 @@ pub mod geom;
 pub mod image;
 pub mod morph;
 pub mod scene;
+pub mod snake;
 pub mod views;
 pub mod warp;
 
