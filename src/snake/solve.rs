@@ -67,8 +67,8 @@ impl Banded {
                 b[i] -= self.l2[i] * b[i - 2];
             }
         }
-        for i in 0..n {
-            b[i] /= self.d[i];
+        for (v, d) in b.iter_mut().zip(&self.d) {
+            *v /= d;
         }
         for i in (0..n).rev() {
             if i + 1 < n {
