@@ -8,11 +8,12 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use morphfx::features::{Feature, Side};
+use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::resample::{resample, ResampleSettings};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
+use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
 use morphfx::warp::mesh::{self, Mesh, MeshWarp};
 use morphfx::warp::triangles::TriangleWarp;
@@ -236,8 +237,41 @@ fn bench_triangles(c: &mut Criterion) {
     g.finish();
 }
 
+fn bench_snakes(c: &mut Criterion) {
+    let src = plate(0.0);
+    let mut g = c.benchmark_group("snakes_1080p");
+    g.sample_size(10);
+    g.bench_function("edge_energy_sigma3", |b| {
+        b.iter(|| black_box(EdgeEnergy::new(src.view(), 3.0)))
+    });
+    let energy = EdgeEnergy::new(src.view(), 3.0);
+    let settings = SnakeSettings::default();
+    // 20 three-point polylines (41 snake points each) spread over the frame.
+    let polylines: Vec<Vec<Vec2>> = line_pairs(20, 3)
+        .into_iter()
+        .map(|l| {
+            vec![
+                l.dst.0,
+                (l.dst.0 + l.dst.1) * 0.5 + Vec2::new(3.0, -2.0),
+                l.dst.1,
+            ]
+        })
+        .collect();
+    g.bench_function("20_polylines_200_iterations", |b| {
+        b.iter(|| {
+            for p in &polylines {
+                let mut snake = Snake::from_primitive(FeatureKind::Polyline, p, &settings);
+                snake.run(&energy, &settings);
+                black_box(&snake.points);
+            }
+        })
+    });
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    bench_snakes,
     bench_field,
     bench_resample,
     bench_morph,

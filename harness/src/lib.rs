@@ -4,3 +4,4 @@
 pub mod host;
 pub mod io;
 pub mod sequence;
+pub mod snap;

@@ -9,9 +9,11 @@ use clap::{Parser, Subcommand};
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx::scene::Scene;
+use morphfx::snake::SnakeSettings;
 use morphfx_harness::host::{Bundle, ErrorKind, Frame, FrameSource, HostError, OutputSpec};
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 use morphfx_harness::sequence::{frame_path, is_sequence, parse_frames};
+use morphfx_harness::snap::Snap;
 
 const MORPH_ID: &str = "net.morphfx.Morph";
 const WARP_ID: &str = "net.morphfx.Warp";
@@ -95,6 +97,31 @@ enum Command {
     },
     /// List the plugins in the bundle.
     Plugins,
+    /// Refine the scene's polylines and curves onto nearby edges of A and B
+    /// with snakes, and write the refined scene.
+    Snap {
+        #[arg(long)]
+        scene: PathBuf,
+        #[arg(long)]
+        a: String,
+        #[arg(long)]
+        b: String,
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// The keyframe to refine (scenes with keyframes), and the frame of
+        /// #-numbered plates.
+        #[arg(long)]
+        frame: Option<f64>,
+        /// Edge smoothing, pixels: edges attract snakes from about twice this.
+        #[arg(long, default_value_t = 3.0)]
+        sigma: f64,
+        /// Iterations of the snake loop.
+        #[arg(long, default_value_t = 200)]
+        iterations: usize,
+        /// Hold the samples on the primitives' control points still.
+        #[arg(long)]
+        clamp_controls: bool,
+    },
     /// Time a whole sequence morph on generated plates (EXR IO included) and
     /// say where the time went.
     Bench {
@@ -121,6 +148,34 @@ fn main() {
 }
 
 fn run(cli: Cli) -> Result<(), HostError> {
+    // Snap works on the plates with the core's snakes; it needs no bundle.
+    if let Command::Snap {
+        scene,
+        a,
+        b,
+        output,
+        frame,
+        sigma,
+        iterations,
+        clamp_controls,
+    } = &cli.command
+    {
+        let settings = SnakeSettings {
+            iterations: *iterations,
+            clamp_controls: *clamp_controls,
+            ..SnakeSettings::default()
+        };
+        return Snap {
+            scene,
+            a,
+            b,
+            output,
+            frame: *frame,
+            sigma: *sigma,
+            settings,
+        }
+        .run();
+    }
     let bundle_path = find_bundle(cli.bundle.as_deref())?;
     match cli.command {
         Command::Plugins => {
@@ -186,6 +241,7 @@ fn run(cli: Cli) -> Result<(), HostError> {
             job.run(&bundle_path)
         }
         Command::Demo { output } => demo(&bundle_path, &output),
+        Command::Snap { .. } => unreachable!("handled before the bundle is looked for"),
         Command::Bench {
             output,
             frames,

@@ -1,0 +1,177 @@
+//! `morphfx snap`: refines a scene's polylines and curves on both images with
+//! snakes (seed 000 §4.2) and writes the refined scene. A feature tool, not a
+//! render: it runs the core's snakes on the plates directly.
+//!
+//! Each polyline or curve is sampled into snake points on A and on B (the
+//! same sampling, so the sides still correspond point for point), the snakes
+//! slither onto nearby edges, and the feature is written back as a polyline
+//! through the snake points. Points and lines are left as they are.
+
+use std::path::Path;
+
+use morphfx::features::FeatureKind;
+use morphfx::geom::Vec2;
+use morphfx::scene::Scene;
+use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
+use serde_json::Value;
+
+use crate::host::HostError;
+use crate::io;
+use crate::sequence::{frame_path, is_sequence};
+
+/// What `snap` was asked to do.
+pub struct Snap<'a> {
+    pub scene: &'a Path,
+    pub a: &'a str,
+    pub b: &'a str,
+    pub output: &'a Path,
+    /// The keyframe to refine (scenes with keyframes), and the frame of
+    /// `#`-numbered plates.
+    pub frame: Option<f64>,
+    /// Gaussian σ of the edge energy, pixels: edges attract from about 2σ.
+    pub sigma: f64,
+    pub settings: SnakeSettings,
+}
+
+impl Snap<'_> {
+    pub fn run(&self) -> Result<(), HostError> {
+        let text = std::fs::read_to_string(self.scene)
+            .map_err(|e| HostError::bad(format!("scene {}: {e}", self.scene.display())))?;
+        // The whole scene is validated first; edits go to the JSON itself so
+        // every key this tool does not touch is written back unchanged.
+        let scene = Scene::parse(&text)
+            .map_err(|e| HostError::bad(format!("scene {}: {e}", self.scene.display())))?;
+        let mut doc: Value = serde_json::from_str(&text)
+            .map_err(|e| HostError::bad(format!("scene {}: {e}", self.scene.display())))?;
+        let features = self.features_to_refine(&scene, &mut doc)?;
+
+        let frame = self.frame.unwrap_or(0.0).round() as i64;
+        let plate = |pattern: &str| {
+            let path = if is_sequence(pattern) {
+                if self.frame.is_none() {
+                    return Err(HostError::bad(format!(
+                        "{pattern}: a numbered sequence needs --frame"
+                    )));
+                }
+                frame_path(pattern, frame)
+            } else {
+                pattern.into()
+            };
+            io::read(&path)
+        };
+        let (pa, pb) = (plate(self.a)?, plate(self.b)?);
+        if !(self.sigma.is_finite() && self.sigma > 0.0 && self.sigma <= 100.0) {
+            return Err(HostError::bad(format!(
+                "--sigma {}: must be between 0 and 100 pixels",
+                self.sigma
+            )));
+        }
+        let energy_a = EdgeEnergy::new(pa.image.view(), self.sigma);
+        let energy_b = EdgeEnergy::new(pb.image.view(), self.sigma);
+
+        let mut refined = 0;
+        let mut moved = 0.0f64;
+        for f in features.as_array_mut().into_iter().flatten() {
+            let kind = f
+                .get("type")
+                .and_then(Value::as_str)
+                .and_then(FeatureKind::parse);
+            if !matches!(kind, Some(FeatureKind::Polyline | FeatureKind::Curve)) {
+                continue;
+            }
+            let kind = kind.expect("checked above");
+            let mut side = |key: &str, energy: &EdgeEnergy| -> Vec<Vec2> {
+                let controls = points(&f[key]);
+                let mut snake = Snake::from_primitive(kind, &controls, &self.settings);
+                let before = snake.points.clone();
+                snake.run(energy, &self.settings);
+                moved = before
+                    .iter()
+                    .zip(&snake.points)
+                    .map(|(a, b)| a.distance(*b))
+                    .fold(moved, f64::max);
+                snake.points
+            };
+            let (a, b) = (side("a", &energy_a), side("b", &energy_b));
+            f["type"] = Value::from("polyline");
+            f["a"] = to_json(&a);
+            f["b"] = to_json(&b);
+            refined += 1;
+        }
+        let out = serde_json::to_string_pretty(&doc)
+            .map_err(|e| HostError::failed(format!("cannot write the scene: {e}")))?;
+        // The result must be a valid scene before it replaces anything.
+        Scene::parse(&out)
+            .map_err(|e| HostError::failed(format!("refined scene is invalid: {e}")))?;
+        write_atomically(self.output, &out)?;
+        println!(
+            "snap: refined {refined} polyline/curve feature(s) on both images (largest move {moved:.2} px) -> {}",
+            self.output.display()
+        );
+        Ok(())
+    }
+
+    /// The feature list to edit: the static features, or the keyframe at
+    /// `--frame` when the scene has keyframes.
+    fn features_to_refine<'d>(
+        &self,
+        scene: &Scene,
+        doc: &'d mut Value,
+    ) -> Result<&'d mut Value, HostError> {
+        if scene.keyframes.is_empty() {
+            return Ok(&mut doc["features"]);
+        }
+        let Some(frame) = self.frame else {
+            let keys: Vec<String> = scene
+                .keyframes
+                .iter()
+                .map(|k| k.frame.to_string())
+                .collect();
+            return Err(HostError::bad(format!(
+                "the scene has keyframes ({}): say which to refine with --frame",
+                keys.join(", ")
+            )));
+        };
+        let keys = doc["keyframes"]
+            .as_array_mut()
+            .expect("validated keyframes");
+        keys.iter_mut()
+            .find(|k| k["frame"].as_f64() == Some(frame))
+            .map(|k| &mut k["features"])
+            .ok_or_else(|| HostError::bad(format!("--frame {frame}: no keyframe at that frame")))
+    }
+}
+
+fn points(v: &Value) -> Vec<Vec2> {
+    v.as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|p| Some(Vec2::new(p.get(0)?.as_f64()?, p.get(1)?.as_f64()?)))
+        .collect()
+}
+
+fn to_json(points: &[Vec2]) -> Value {
+    // Millipixel precision keeps the file readable.
+    let r = |v: f64| (v * 1000.0).round() / 1000.0;
+    Value::from(
+        points
+            .iter()
+            .map(|p| Value::from(vec![r(p.x), r(p.y)]))
+            .collect::<Vec<_>>(),
+    )
+}
+
+fn write_atomically(path: &Path, text: &str) -> Result<(), HostError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
+    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            HostError::bad(format!("{}: cannot write: {e}", path.display()))
+        })
+}

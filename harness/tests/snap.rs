@@ -1,0 +1,142 @@
+//! `morphfx snap`: polylines and curves of a scene refined onto nearby edges
+//! of both plates, everything else written back as it was.
+
+use std::path::Path;
+
+mod common;
+
+use morphfx::geom::RectI;
+use morphfx::image::Image;
+use morphfx::scene::Scene;
+use morphfx_harness::io::{self, ExrPrecision, Plate};
+
+/// A 96×64 plate with a vertical step edge at canonical x = `edge`.
+fn write_step(path: &Path, edge: f64) {
+    let img = Image::from_fn(RectI::from_size(96, 64), 4, |i, _, c| {
+        if c == 3 {
+            1.0
+        } else if (i as f64 + 0.5) < edge {
+            0.05
+        } else {
+            0.8
+        }
+    });
+    io::write(
+        path,
+        &Plate {
+            image: img,
+            size: (96, 64),
+        },
+        ExrPrecision::Float,
+    )
+    .unwrap();
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+const SCENE: &str = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
+  "field": {"b": 1.5},
+  "features": [
+    {"name": "edge", "type": "curve", "a": [[44, 10], [45, 32], [44, 54]], "b": [[48, 10], [47, 32], [48, 54]]},
+    {"name": "dot", "type": "point", "a": [[20, 20]], "b": [[22, 21]]}
+  ]}"#;
+
+#[test]
+fn snap_moves_curves_onto_the_edges_of_each_plate_and_keeps_the_rest() {
+    let d = common::scratch("snap");
+    write_step(&d.join("a.exr"), 40.0);
+    write_step(&d.join("b.exr"), 52.0);
+    std::fs::write(d.join("s.json"), SCENE).unwrap();
+    let out = d.join("snapped.json");
+    let r = common::run_morphfx(&[
+        "snap",
+        "--scene",
+        s(&d.join("s.json")),
+        "--a",
+        s(&d.join("a.exr")),
+        "--b",
+        s(&d.join("b.exr")),
+        "-o",
+        s(&out),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let scene = Scene::parse(&text).unwrap();
+    let edge = &scene.features[0];
+    assert_eq!(edge.name.as_deref(), Some("edge"));
+    assert_eq!(edge.kind.name(), "polyline");
+    assert_eq!(edge.a.len(), 41);
+    assert_eq!(edge.b.len(), 41);
+    for p in &edge.a {
+        assert!((p.x - 40.0).abs() < 0.5, "A point {p:?}");
+    }
+    for p in &edge.b {
+        assert!((p.x - 52.0).abs() < 0.5, "B point {p:?}");
+    }
+    // Untouched: the point feature and the field settings.
+    let original = Scene::parse(SCENE).unwrap();
+    assert_eq!(scene.features[1], original.features[1]);
+    assert_eq!(scene.field, original.field);
+}
+
+#[test]
+fn snap_refuses_bad_input_without_writing() {
+    let d = common::scratch("snap-bad");
+    write_step(&d.join("a.exr"), 40.0);
+    std::fs::write(d.join("s.json"), SCENE).unwrap();
+    let out = d.join("snapped.json");
+    // A missing plate.
+    let r = common::run_morphfx(&[
+        "snap",
+        "--scene",
+        s(&d.join("s.json")),
+        "--a",
+        s(&d.join("a.exr")),
+        "--b",
+        s(&d.join("missing.exr")),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("missing.exr"));
+    assert!(!out.exists());
+    // A keyframed scene without --frame.
+    let keyed = r#"{"keyframes": [{"frame": 5, "features": [{"type": "polyline", "a": [[44, 10], [44, 54]], "b": [[48, 10], [48, 54]]}]}]}"#;
+    std::fs::write(d.join("k.json"), keyed).unwrap();
+    let r = common::run_morphfx(&[
+        "snap",
+        "--scene",
+        s(&d.join("k.json")),
+        "--a",
+        s(&d.join("a.exr")),
+        "--b",
+        s(&d.join("a.exr")),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--frame"));
+    assert!(!out.exists());
+    // With --frame 5 it refines that keyframe.
+    let r = common::run_morphfx(&[
+        "snap",
+        "--scene",
+        s(&d.join("k.json")),
+        "--a",
+        s(&d.join("a.exr")),
+        "--b",
+        s(&d.join("a.exr")),
+        "--frame",
+        "5",
+        "-o",
+        s(&out),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let scene = Scene::parse(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert!(scene.keyframes[0].features[0]
+        .a
+        .iter()
+        .all(|p| (p.x - 40.0).abs() < 0.5));
+}
