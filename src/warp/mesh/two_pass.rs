@@ -252,42 +252,44 @@ impl Buffers {
 /// Where each column spline of `mesh` (x as a function of y) crosses each
 /// height of `at`: `[j * cols + c]`.
 fn column_crossings(mesh: &Mesh, at: &[f64]) -> Vec<f64> {
-    let (rows, cols) = (mesh.rows(), mesh.cols());
-    let mut table = vec![0.0; at.len() * cols];
-    let mut out = vec![0.0; at.len()];
-    for c in 0..cols {
-        let mut ys: Vec<f64> = (0..rows).map(|r| mesh.node(r, c).y).collect();
-        let mut xs: Vec<f64> = (0..rows).map(|r| mesh.node(r, c).x).collect();
-        spline::increasing(&mut ys, &mut xs);
-        if ys.len() >= 2 {
-            spline::eval_sorted(&ys, &xs, Beyond::Hold, at, &mut out);
-        } else {
-            out.fill(xs[0]);
-        }
-        for (j, v) in out.iter().enumerate() {
-            table[j * cols + c] = *v;
-        }
-    }
-    table
+    let splines = (0..mesh.cols()).map(|c| {
+        (0..mesh.rows())
+            .map(move |r| mesh.node(r, c))
+            .map(|p| (p.y, p.x))
+    });
+    crossings(splines, mesh.cols(), at)
 }
 
 /// Where each row spline of `mesh` (y as a function of x) crosses each
 /// abscissa of `at`: `[k * rows + r]`.
 fn row_crossings(mesh: &Mesh, at: &[f64]) -> Vec<f64> {
-    let (rows, cols) = (mesh.rows(), mesh.cols());
-    let mut table = vec![0.0; at.len() * rows];
+    let splines = (0..mesh.rows()).map(|r| {
+        (0..mesh.cols())
+            .map(move |c| mesh.node(r, c))
+            .map(|p| (p.x, p.y))
+    });
+    crossings(splines, mesh.rows(), at)
+}
+
+/// Each spline (knot, value pairs) taken at every position of `at`, as a
+/// table `[position * count + spline]`.
+fn crossings<I, S>(splines: I, count: usize, at: &[f64]) -> Vec<f64>
+where
+    I: Iterator<Item = S>,
+    S: Iterator<Item = (f64, f64)>,
+{
+    let mut table = vec![0.0; at.len() * count];
     let mut out = vec![0.0; at.len()];
-    for r in 0..rows {
-        let mut xs: Vec<f64> = (0..cols).map(|c| mesh.node(r, c).x).collect();
-        let mut ys: Vec<f64> = (0..cols).map(|c| mesh.node(r, c).y).collect();
-        spline::increasing(&mut xs, &mut ys);
-        if xs.len() >= 2 {
-            spline::eval_sorted(&xs, &ys, Beyond::Hold, at, &mut out);
+    for (i, spline) in splines.enumerate() {
+        let (mut knots, mut values): (Vec<f64>, Vec<f64>) = spline.unzip();
+        spline::increasing(&mut knots, &mut values);
+        if knots.len() >= 2 {
+            spline::eval_sorted(&knots, &values, Beyond::Hold, at, &mut out);
         } else {
-            out.fill(ys[0]);
+            out.fill(values[0]);
         }
-        for (k, v) in out.iter().enumerate() {
-            table[k * rows + r] = *v;
+        for (j, v) in out.iter().enumerate() {
+            table[j * count + i] = *v;
         }
     }
     table
