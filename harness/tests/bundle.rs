@@ -367,6 +367,9 @@ fn every_param_is_declared_with_label_hint_and_script_name() {
         "evaluation",
         "tolerance",
         "line_count",
+        "snap_lines",
+        "snap_sigma",
+        "mesh_pass",
         "scene_file",
         "scene_text",
         "frame_offset_a",
@@ -518,4 +521,65 @@ fn mesh_and_triangle_renders_match_the_core_at_every_depth_scale_and_layout() {
             "{method:?}: tiles differ from the whole frame"
         );
     }
+}
+
+/// A plate with a vertical step edge at canonical x = `edge`.
+fn step_plate(bounds: RectI, edge: f64) -> Image {
+    Image::from_fn(bounds, 4, |i, _, c| {
+        if c == 3 {
+            1.0
+        } else if (i as f64 + 0.5) < edge {
+            0.1
+        } else {
+            0.9
+        }
+    })
+}
+
+#[test]
+fn snap_lines_keys_each_side_onto_its_own_edge_at_the_current_frame() {
+    let bounds = RectI::new(0, 0, 64, 48);
+    for depth in ["OfxBitDepthByte", "OfxBitDepthFloat"] {
+        let inst = bundle()
+            .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+            .unwrap();
+        let fa = Arc::new(Frame::from_image(&step_plate(bounds, 24.0), depth, false));
+        let fb = Arc::new(Frame::from_image(&step_plate(bounds, 36.0), depth, true));
+        inst.connect("SourceA", Arc::new(Still(fa))).unwrap();
+        inst.connect("SourceB", Arc::new(Still(fb))).unwrap();
+        inst.set_int("line_count", 1).unwrap();
+        // Roughly placed: A 4 px right of its edge, B 4 px left of its own.
+        inst.set_double("line1_a_start", &[28.0, 8.0], None)
+            .unwrap();
+        inst.set_double("line1_a_end", &[27.0, 40.0], None).unwrap();
+        inst.set_double("line1_b_start", &[32.0, 8.0], None)
+            .unwrap();
+        inst.set_double("line1_b_end", &[32.5, 40.0], None).unwrap();
+        inst.instance_changed("snap_lines", 7.0).unwrap();
+        for (id, edge) in [
+            ("line1_a_start", 24.0),
+            ("line1_a_end", 24.0),
+            ("line1_b_start", 36.0),
+            ("line1_b_end", 36.0),
+        ] {
+            let v = inst.doubles_at(id, 7.0).unwrap();
+            assert!((v[0] - edge).abs() < 0.5, "{depth} {id}: {v:?}");
+        }
+        // Keyed at frame 7: the slot is animated now, frame 7 holds the key.
+        let a_end = inst.doubles_at("line1_a_end", 7.0).unwrap();
+        assert!(
+            (a_end[1] - 40.0).abs() < 2.0,
+            "the line kept its length: {a_end:?}"
+        );
+    }
+}
+
+#[test]
+fn snap_lines_without_a_source_is_bad_input() {
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    inst.set_int("line_count", 1).unwrap();
+    let err = inst.instance_changed("snap_lines", 1.0).unwrap_err();
+    assert!(err.message.contains("SourceA"), "{}", err.message);
 }

@@ -438,6 +438,36 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// The values of a double-valued param at `time` (keys interpolated).
+    pub fn doubles_at(&self, name: &str, time: f64) -> Result<Vec<f64>, HostError> {
+        let p = self.param(name)?;
+        let n = match p.shape() {
+            params::Shape::Double(n) => n,
+            _ => return Err(HostError::bad(format!("{name} is not a double param"))),
+        };
+        Ok(p.value_at(time).d[..n].to_vec())
+    }
+
+    /// Tells the plugin the user changed (or pressed) param `name` at `time`.
+    pub fn instance_changed(&self, name: &str, time: f64) -> Result<(), HostError> {
+        *self
+            .effect
+            .render_scale
+            .lock()
+            .unwrap_or_else(|e| e.into_inner()) = (1.0, 1.0);
+        let name = CString::new(name).map_err(|_| HostError::bad("NUL in a param name"))?;
+        let a = PropertySet::new();
+        a.set_str(kOfxPropType, "OfxTypeParameter");
+        a.set_str(kOfxPropName, &name.to_string_lossy());
+        a.set_str(kOfxPropChangeReason, "OfxChangeUserEdited");
+        a.set_double(kOfxPropTime, &[time]);
+        a.set_double(kOfxImageEffectPropRenderScale, &[1.0, 1.0]);
+        self.act(kOfxActionBeginInstanceChanged, Some(&a), None)?;
+        let result = self.act(kOfxActionInstanceChanged, Some(&a), None);
+        self.act(kOfxActionEndInstanceChanged, Some(&a), None)?;
+        result.map(|_| ())
+    }
+
     pub fn set_int(&self, name: &str, value: i32) -> Result<(), HostError> {
         let p = self.param(name)?;
         let mut v = ParamValue::default();

@@ -5,6 +5,7 @@ mod instance;
 pub mod morph;
 pub mod params;
 mod render;
+mod snap;
 pub mod spec;
 pub mod warp;
 
@@ -98,6 +99,8 @@ pub fn action(
         render::frames_needed(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionRender) {
         render::render(kind, &effect, &in_props()?)?;
+    } else if is(action, kOfxActionInstanceChanged) {
+        snap::instance_changed(kind, &effect, &in_props()?)?;
     } else {
         return Ok(kOfxStatReplyDefault);
     }

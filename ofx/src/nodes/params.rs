@@ -34,6 +34,8 @@ pub const FILTER: &str = "filter";
 pub const EDGE: &str = "edge";
 pub const VIEW: &str = "view";
 pub const MESH_PASS: &str = "mesh_pass";
+pub const SNAP_LINES: &str = "snap_lines";
+pub const SNAP_SIGMA: &str = "snap_sigma";
 
 /// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
 pub fn slot_ids(k: usize) -> [String; 5] {
@@ -100,6 +102,8 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", Kind::Choice { options: vec!["two-pass", "one-pass"], default: 0 }).in_group("mesh_group").animated(false),
         ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
+        ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(SNAP_SIGMA, "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Kind::Double { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group("lines_group").animated(false),
     ];
     for k in 1..=LINE_SLOTS {
         let [enable, a0, a1, b0, b1] = slot_ids(k);

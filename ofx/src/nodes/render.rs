@@ -26,7 +26,7 @@ use crate::wrapper::{Failure, Outcome};
 
 const TRANSITION: &str = "OfxImageEffectContextTransition";
 
-fn context(effect: &Effect) -> String {
+pub(super) fn context(effect: &Effect) -> String {
     effect
         .props()
         .and_then(|p| p.get_string(kOfxImageEffectPropContext, 0))

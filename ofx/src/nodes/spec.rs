@@ -39,6 +39,8 @@ pub enum Kind {
     Group {
         open: bool,
     },
+    /// A push-button: no value, it sends instanceChanged when pressed.
+    Button,
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -34,6 +34,7 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
         Kind::Point { .. } => kOfxParamTypeDouble2D,
         Kind::Text { .. } => kOfxParamTypeString,
         Kind::Group { .. } => kOfxParamTypeGroup,
+        Kind::Button => kOfxParamTypePushButton,
     };
     let name = cstr(&spec.id);
     let mut props: OfxPropertySetHandle = std::ptr::null_mut();
@@ -117,6 +118,7 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
         Kind::Group { open } => {
             let _ = p.set_int(kOfxParamPropGroupOpen, 0, *open as i32);
         }
+        Kind::Button => {}
     }
     Ok(())
 }
@@ -207,6 +209,17 @@ impl Params {
             &format!("reading {id}"),
         )?;
         Ok((x, y))
+    }
+
+    /// Keys a Double2D param at `time` (the host adds or moves the key).
+    pub fn set_point_at(&self, id: &str, time: f64, (x, y): (f64, f64)) -> Outcome {
+        let f = self
+            .suite
+            .paramSetValueAtTime
+            .ok_or_else(|| Failure::Failed("host has no paramSetValueAtTime".into()))?;
+        let h = self.handle(id)?;
+        // SAFETY: a Double2D param takes two `double` varargs after the time.
+        check(unsafe { f(h, time, x, y) }, &format!("setting {id}"))
     }
 
     pub fn string(&self, id: &str, time: f64) -> Outcome<String> {

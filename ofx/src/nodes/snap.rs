@@ -1,0 +1,103 @@
+//! The Snap Lines push-button (seed 000 §4.2): every enabled line slot slides
+//! onto the nearest strong edge of its source at the current frame — A
+//! positions on Source A, B positions on Source B (Morph) — and the moved
+//! endpoints are keyed there, so the user places lines roughly and lets the
+//! image finish the job.
+
+use morphfx::features::FeatureKind;
+use morphfx::geom::{PixelScale, Vec2};
+use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
+use openfx::sys::generic::core::*;
+
+use super::params::{slot_ids, Settings, LINE_COUNT, LINE_SLOTS, SNAP_LINES, SNAP_SIGMA};
+use super::render::context;
+use super::{instance, NodeKind};
+use crate::wrapper::clips::{Depth, Effect};
+use crate::wrapper::props::PropSet;
+use crate::wrapper::{Failure, Outcome};
+
+/// Handles instanceChanged: only the Snap Lines button does anything.
+pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
+    if in_args.get_string(kOfxPropName, 0)? != SNAP_LINES {
+        return Ok(());
+    }
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let params = effect.params()?;
+    let settings = Settings::read(&params, time, kind);
+    let sigma = params
+        .double(SNAP_SIGMA, time)
+        .unwrap_or(3.0)
+        .clamp(0.5, 50.0);
+    let (a, b) = kind.source_clips(&context(effect));
+    let energy_a = edge_energy(effect, a, time + settings.offset_a as f64, sigma)?;
+    let energy_b = match b {
+        Some(b) => Some(edge_energy(
+            effect,
+            b,
+            time + settings.offset_b as f64,
+            sigma,
+        )?),
+        None => None,
+    };
+    let count = params.int(LINE_COUNT, time)?.clamp(0, LINE_SLOTS as i32) as usize;
+    for k in 1..=count {
+        let [enable, a0, a1, b0, b1] = slot_ids(k);
+        if params.int(&enable, time)? == 0 {
+            continue;
+        }
+        let sides =
+            std::iter::once((a0, a1, &energy_a)).chain(energy_b.as_ref().map(|e| (b0, b1, e)));
+        for (start, end, (energy, scale)) in sides {
+            let p = Vec2::from(<[f64; 2]>::from(params.point(&start, time)?));
+            let q = Vec2::from(<[f64; 2]>::from(params.point(&end, time)?));
+            if p == q || !(p.is_finite() && q.is_finite()) {
+                continue;
+            }
+            let [p, q] = snap_line([p, q], energy, *scale);
+            params.set_point_at(&start, time, (p.x, p.y))?;
+            params.set_point_at(&end, time, (q.x, q.y))?;
+        }
+    }
+    instance::get(effect)?.purge();
+    Ok(())
+}
+
+/// The line `p → q` (canonical) snaked on `energy` (pixels at `scale`) and
+/// unsnaked back to its two endpoints.
+fn snap_line(line: [Vec2; 2], energy: &EdgeEnergy, scale: PixelScale) -> [Vec2; 2] {
+    let settings = SnakeSettings::default();
+    let px = line.map(|p| scale.to_pixel(p));
+    let mut snake = Snake::from_primitive(FeatureKind::Polyline, &px, &settings);
+    snake.run(energy, &settings);
+    let back = snake.unsnake();
+    [0, 1].map(|k| Vec2::new(back[k].x / scale.x, back[k].y / scale.y))
+}
+
+/// The edge energy of clip `name` at `time`, and the pixel scale it is in.
+fn edge_energy(
+    effect: &Effect,
+    name: &str,
+    time: f64,
+    sigma: f64,
+) -> Outcome<(EdgeEnergy, PixelScale)> {
+    let clip = effect.clip(name)?;
+    if !clip.is_connected() {
+        return Err(Failure::BadInput(format!(
+            "Snap Lines needs clip {name} connected"
+        )));
+    }
+    let image = clip.image(time)?.ok_or_else(|| {
+        Failure::BadInput(format!(
+            "Snap Lines: clip {name} has no image at frame {time}"
+        ))
+    })?;
+    let info = image.info()?;
+    let scale = PixelScale::new(info.render_scale.0, info.render_scale.1, info.par);
+    let sigma = sigma * scale.y;
+    let energy = match info.depth {
+        Depth::U8 => EdgeEnergy::new(image.view::<u8>(&info)?, sigma),
+        Depth::U16 => EdgeEnergy::new(image.view::<u16>(&info)?, sigma),
+        Depth::F32 => EdgeEnergy::new(image.view::<f32>(&info)?, sigma),
+    };
+    Ok((energy, scale))
+}
