@@ -29,11 +29,14 @@ impl EdgeEnergy {
             .for_each(|(r, out)| {
                 let row = view.row(b.y1 + r as i32);
                 for (o, px) in out.iter_mut().zip(row.chunks_exact(c)) {
-                    *o = if c >= 3 {
+                    let v = if c >= 3 {
                         0.2126 * px[0].to_f32() + 0.7152 * px[1].to_f32() + 0.0722 * px[2].to_f32()
                     } else {
                         px[0].to_f32()
                     };
+                    // NaN or infinite pixels (HDR renders have them) count as black,
+                    // so every force stays finite.
+                    *o = if v.is_finite() { v } else { 0.0 };
                 }
             });
         let smooth = gaussian(&lum, w, h, sigma);

@@ -88,3 +88,17 @@ fn without_edges_nothing_pulls_and_straight_snakes_stay_put() {
         assert!(a.distance(*b) < 1e-9, "{a:?} → {b:?}");
     }
 }
+
+#[test]
+fn non_finite_pixels_keep_the_snake_finite() {
+    let mut img = step(40.0);
+    for v in img.data.iter_mut().step_by(7) {
+        *v = f32::NAN;
+    }
+    img.data[100] = f32::INFINITY;
+    let energy = EdgeEnergy::new(img.view(), 3.0);
+    let settings = SnakeSettings::default();
+    let mut snake = Snake::from_primitive(FeatureKind::Polyline, &polyline(44.0), &settings);
+    snake.run(&energy, &settings);
+    assert!(snake.points.iter().all(|p| p.is_finite()));
+}

@@ -70,7 +70,13 @@ fn snap_line(line: [Vec2; 2], energy: &EdgeEnergy, scale: PixelScale) -> [Vec2; 
     let mut snake = Snake::from_primitive(FeatureKind::Polyline, &px, &settings);
     snake.run(energy, &settings);
     let back = snake.unsnake();
-    [0, 1].map(|k| Vec2::new(back[k].x / scale.x, back[k].y / scale.y))
+    let moved = [0, 1].map(|k| Vec2::new(back[k].x / scale.x, back[k].y / scale.y));
+    // Never key a non-finite position: leave such a line where it was.
+    if moved.iter().all(|p| p.is_finite()) {
+        moved
+    } else {
+        line
+    }
 }
 
 /// The edge energy of clip `name` at `time`, and the pixel scale it is in.

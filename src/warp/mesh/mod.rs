@@ -31,8 +31,9 @@ pub struct Mesh {
     nodes: Vec<Vec2>,
 }
 
-/// Sizes beyond this are surely a mistake (and would make the tables huge).
-pub const MAX_SIZE: usize = 1024;
+/// Sizes beyond this are surely a mistake (a 256 × 256 mesh already holds
+/// 65 536 hand-placed nodes, and its patch tables take 16 MB).
+pub const MAX_SIZE: usize = 256;
 
 impl Mesh {
     /// A mesh from its nodes; sizes are checked here, geometry by [`Mesh::check`].
