@@ -790,6 +790,57 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
         },
     };
     job.run(bundle_path)?;
+
+    // The same morph through the mesh and triangle methods: a 5 × 5 mesh whose
+    // inner ring opens from the round face to the square one, and the
+    // features above triangulated.
+    let mut nodes_a = Vec::new();
+    let mut nodes_b = Vec::new();
+    for r in 0..5 {
+        for c in 0..5 {
+            let p = [c as f64 * w as f64 / 4.0, r as f64 * h as f64 / 4.0];
+            let inner = (1..4).contains(&r) && (1..4).contains(&c);
+            let q = if inner && (r, c) != (2, 2) {
+                [cx + (p[0] - cx) * 1.12, cy + (p[1] - cy) * 1.12]
+            } else {
+                p
+            };
+            nodes_a.push(p);
+            nodes_b.push(q);
+        }
+    }
+    let mut mesh_scene = scene.clone();
+    mesh_scene["method"] = "mesh".into();
+    mesh_scene["mesh"] = serde_json::json!({ "rows": 5, "cols": 5, "a": nodes_a, "b": nodes_b });
+    let mut triangles_scene = scene.clone();
+    triangles_scene["method"] = "triangles".into();
+    for (name, scene) in [("mesh", mesh_scene), ("triangles", triangles_scene)] {
+        let path = dir.join(format!("{name}.morph.json"));
+        std::fs::write(
+            &path,
+            serde_json::to_string_pretty(&scene).unwrap_or_default(),
+        )
+        .map_err(|e| HostError::failed(format!("{}: {e}", path.display())))?;
+        let job = Job {
+            plugin: MORPH_ID,
+            context: "OfxImageEffectContextGeneral",
+            sources: vec![
+                ("SourceA".into(), s(plates.join("a.exr"))),
+                ("SourceB".into(), s(plates.join("b.exr"))),
+            ],
+            view: "morph".into(),
+            extra: Vec::new(),
+            common: Common {
+                scene: Some(path),
+                line: Vec::new(),
+                t: None,
+                frames: Some("1-12".into()),
+                output: s(dir.join(format!("{name}/morph.####.png"))),
+                half: false,
+            },
+        };
+        job.run(bundle_path)?;
+    }
     println!(
         "MorphFX demo rendered through {}",
         morphfx_harness::host::bundle_binary(bundle_path).display()
@@ -807,6 +858,11 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
     println!(
         "  ST maps:  {} (A's warp per frame)",
         dir.join("stmap_a.####.exr").display()
+    );
+    println!(
+        "  methods:  {} and {} (the same morph by mesh and by triangles, PNG)",
+        dir.join("mesh/morph.####.png").display(),
+        dir.join("triangles/morph.####.png").display()
     );
     Ok(())
 }

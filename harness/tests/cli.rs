@@ -246,3 +246,44 @@ fn a_panic_inside_the_plugin_becomes_a_failure_status_not_a_crash() {
     );
     assert!(!out.exists());
 }
+
+/// The demo renders the same morph by field, mesh and triangles; whatever
+/// the method, the first frame (t = 0) is plate A and the last (t = 1) plate
+/// B, pixel for pixel.
+#[test]
+fn demo_renders_every_built_method_with_exact_end_frames() {
+    let d = tmp("demo");
+    let (code, err) = morphfx(&["demo", "-o", d.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let read = |p: PathBuf| {
+        io::read(&p)
+            .unwrap_or_else(|e| panic!("{}: {}", p.display(), e.message))
+            .image
+    };
+    let (a, b) = (read(d.join("plates/a.exr")), read(d.join("plates/b.exr")));
+    for method in ["preview", "mesh", "triangles"] {
+        let first = read(d.join(format!("{method}/morph.0001.png")));
+        let last = read(d.join(format!("{method}/morph.0012.png")));
+        for (got, want, which) in [(&first, &a, "A"), (&last, &b, "B")] {
+            // PNG holds 8 bits: equal to the plate within one step.
+            let worst = got
+                .data
+                .iter()
+                .zip(&want.data)
+                .map(|(g, w)| (g - w.clamp(0.0, 1.0)).abs())
+                .fold(0f32, f32::max);
+            assert!(
+                worst <= 1.0 / 255.0 + 1e-6,
+                "{method}: end frame differs from plate {which} by {worst}"
+            );
+        }
+        let mid = read(d.join(format!("{method}/morph.0006.png")));
+        let moved = mid
+            .data
+            .iter()
+            .zip(&a.data)
+            .map(|(g, w)| (g - w).abs())
+            .fold(0f32, f32::max);
+        assert!(moved > 0.1, "{method}: the middle frame is plate A");
+    }
+}
