@@ -391,17 +391,21 @@ fn add<T: Sample, const C: usize, const AW: bool>(acc: &mut [f32; 4], px: &[T], 
 /// Converts a row of `C`-channel samples to float pixels (alpha-weighted
 /// colour when `AW`), one layout per instance so the loop vectorises.
 fn load<T: Sample, const C: usize, const AW: bool>(row: &[T], out: &mut Vec<[f32; 4]>) {
-    out.extend(row.chunks_exact(C).map(|px| {
+    // Sized first and written in place: `extend` through a mapping iterator
+    // does not vectorise.
+    out.clear();
+    out.resize(row.len() / C, [0.0; 4]);
+    for (o, px) in out.iter_mut().zip(row.chunks_exact(C)) {
         let mut v = [0f32; 4];
         for c in 0..C {
             v[c] = px[c].to_f32();
         }
-        if AW {
+        *o = if AW {
             [v[0] * v[3], v[1] * v[3], v[2] * v[3], v[3]]
         } else {
             v
-        }
-    }));
+        };
+    }
 }
 
 /// Alpha-weighted sums back to straight colour: `acc[3] = Σ w a`,

@@ -25,6 +25,17 @@ pub fn sample(
     read: impl Fn(usize) -> [f32; 4],
 ) -> [f32; 4] {
     let (lo, hi) = if u0 <= u1 { (u0, u1) } else { (u1, u0) };
+    if hi - lo <= 1.0 {
+        // Magnifying or the identity (most pixels of most warps): the unit
+        // box is linear interpolation between the two nearest centres.
+        let c = 0.5 * (lo + hi) - 0.5;
+        let i = c.floor();
+        if i >= 0.0 && i + 2.0 <= n as f64 {
+            let (i0, f) = (i as usize, (c - i) as f32);
+            let (p, q) = (read(i0), read(i0 + 1));
+            return std::array::from_fn(|k| p[k] + f * (q[k] - p[k]));
+        }
+    }
     let len = (hi - lo).max(1.0);
     let a = 0.5 * (lo + hi - len);
     let first = a.floor();
