@@ -31,6 +31,12 @@ pub trait Sample: Copy + Send + Sync + Default + PartialEq + std::fmt::Debug + '
     fn as_f32_mut(_s: &mut [Self]) -> Option<&mut [f32]> {
         None
     }
+
+    /// Read-only [`Sample::as_f32_mut`]: float rows copied, not converted.
+    #[inline(always)]
+    fn as_f32(_s: &[Self]) -> Option<&[f32]> {
+        None
+    }
 }
 
 impl Sample for f32 {
@@ -48,6 +54,10 @@ impl Sample for f32 {
     }
     #[inline(always)]
     fn as_f32_mut(s: &mut [f32]) -> Option<&mut [f32]> {
+        Some(s)
+    }
+    #[inline(always)]
+    fn as_f32(s: &[f32]) -> Option<&[f32]> {
         Some(s)
     }
 }

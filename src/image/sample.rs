@@ -144,6 +144,15 @@ impl<'a, T: Sample> Sampler<'a, T> {
         self.load_span(j, b.x1, b.width(), out);
     }
 
+    /// Row `j` as it lies in memory when that already is what
+    /// [`Sampler::load_row`] would make (float RGBA, premultiplied): no copy.
+    pub fn float_rgba_row(&self, j: i32) -> Option<&'a [[f32; 4]]> {
+        if self.view.channels() != 4 || self.alpha_weighted {
+            return None;
+        }
+        T::as_f32(self.view.row(j)).map(|f| f.as_chunks::<4>().0)
+    }
+
     /// [`Sampler::load_row`] for the `len` pixels from column `i` (inside
     /// the bounds).
     pub fn load_span(&self, j: i32, i: i32, len: usize, out: &mut Vec<[f32; 4]>) {
@@ -394,6 +403,12 @@ fn load<T: Sample, const C: usize, const AW: bool>(row: &[T], out: &mut Vec<[f32
     // Sized first and written in place: `extend` through a mapping iterator
     // does not vectorise.
     out.clear();
+    if C == 4 && !AW {
+        if let Some(floats) = T::as_f32(row) {
+            out.extend_from_slice(floats.as_chunks::<4>().0);
+            return;
+        }
+    }
     out.resize(row.len() / C, [0.0; 4]);
     for (o, px) in out.iter_mut().zip(row.chunks_exact(C)) {
         let mut v = [0f32; 4];

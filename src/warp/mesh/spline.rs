@@ -62,24 +62,35 @@ pub fn eval(x: &[f64], y: &[f64], beyond: Beyond, at: f64) -> f64 {
     Piece::new(x, y, j.min(n - 2)).at(at)
 }
 
-/// The spline at ascending positions `at`, into `out` (one pass over the knots).
+/// The spline at ascending positions `at`, into `out` (one pass over the
+/// knots; each interval's run of positions is a plain loop that vectorises).
 pub fn eval_sorted(x: &[f64], y: &[f64], beyond: Beyond, at: &[f64], out: &mut [f64]) {
     let n = x.len();
     debug_assert!(n >= 2 && y.len() == n && out.len() == at.len());
-    let mut j = 0;
-    let mut piece = Piece::new(x, y, 0);
-    for (o, &p) in out.iter_mut().zip(at) {
-        if p <= x[0] || p >= x[n - 1] {
-            *o = outside(x, y, beyond, p);
-            continue;
+    let m = at.len();
+    let mut k = 0;
+    while k < m && at[k] <= x[0] {
+        out[k] = outside(x, y, beyond, at[k]);
+        k += 1;
+    }
+    for j in 0..n - 1 {
+        if k >= m {
+            return;
         }
-        if p >= x[j + 1] {
-            while p >= x[j + 1] {
-                j += 1;
+        let end = x[j + 1];
+        let first = k;
+        while k < m && at[k] < end {
+            k += 1;
+        }
+        if k > first {
+            let piece = Piece::new(x, y, j);
+            for (o, p) in out[first..k].iter_mut().zip(&at[first..k]) {
+                *o = piece.at(*p);
             }
-            piece = Piece::new(x, y, j);
         }
-        *o = piece.at(p);
+    }
+    for (o, p) in out[k..].iter_mut().zip(&at[k..]) {
+        *o = outside(x, y, beyond, *p);
     }
 }
 

@@ -129,6 +129,14 @@ pub fn two_pass_into<S: Sample>(
                     edges,
                     b.x1 as f64,
                 );
+                if let Some(row) = src.float_rgba_row(b.y1 + r as i32) {
+                    // Float RGBA: read the source row where it lies.
+                    let pre = &buf.pre;
+                    for (k, o) in dst.iter_mut().enumerate() {
+                        *o = fant::sample(pre[k], pre[k + 1], n, edge, |i| row[i]);
+                    }
+                    continue;
+                }
                 // Only the source pixels these preimages reach are converted.
                 let (lo, hi) = span(&buf.pre);
                 let (s0, s1) =
