@@ -3,6 +3,7 @@
 use std::collections::HashSet;
 use std::sync::{Arc, Mutex};
 
+use morphfx::image::Plane;
 use morphfx::scene::Scene;
 
 use crate::cache::WarpCache;
@@ -16,12 +17,22 @@ pub struct Instance {
     pub scene: Mutex<Option<(String, Arc<Scene>)>>,
     /// Warnings already posted (minimal hosts: report each fallback once).
     pub said: Mutex<HashSet<String>>,
+    /// Two-pass output planes kept between renders (at most [`PLANES_KEPT`]):
+    /// fresh frame-sized memory costs more than a tenth of a two-pass warp.
+    pub planes: Mutex<Vec<Plane>>,
 }
+
+/// A morph needs two planes.
+pub const PLANES_KEPT: usize = 2;
 
 impl Instance {
     pub fn purge(&self) {
         self.warps.clear();
         *self.scene.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        self.planes
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
     }
 
     /// True the first time `what` is asked about.

@@ -1,7 +1,7 @@
 //! Render glue: host images in, core calls, host image out. Conversions to
 //! pixel rows, render scale and pixel aspect happen here, once (DESIGN rule 3).
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use morphfx::features::{Feature, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
@@ -16,7 +16,7 @@ use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::message::*;
 
-use super::instance::{self, Instance};
+use super::instance::{self, Instance, PLANES_KEPT};
 use super::params::{Settings, OFFSET_A, OFFSET_B};
 use super::NodeKind;
 use crate::cache::key_of;
@@ -310,6 +310,7 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         } else {
             frame.warp.meshes.as_ref()
         },
+        planes: &instance.planes,
         scale,
         origin,
         size,
@@ -396,6 +397,8 @@ struct Job<'a> {
     map_b: Option<Arc<WarpMap>>,
     /// The mesh pair when pictures come from the two-pass mesh warp.
     meshes: Option<&'a MeshPair>,
+    /// Output planes reused between two-pass renders.
+    planes: &'a Mutex<Vec<Plane>>,
     scale: PixelScale,
     origin: Vec2,
     size: Vec2,
@@ -445,11 +448,21 @@ impl Job<'_> {
         let window = rows.bounds;
         let to = pair.at(self.t);
         let identity = WarpMap::identity(window, self.scale);
+        let pool = || self.planes.lock().unwrap_or_else(|e| e.into_inner());
         let plane = |side: Side, s: &Sampler<'_, S>| {
             let from = pair.side(side);
-            (*from != to).then(|| mesh::two_pass(s, from, &to, window, self.scale))
+            (*from != to).then(|| {
+                let mut p = pool().pop().unwrap_or(Plane {
+                    window,
+                    channels: 0,
+                    pixels: Vec::new(),
+                });
+                p.window = window;
+                mesh::two_pass_into(s, from, &to, self.scale, &mut p);
+                p
+            })
         };
-        match (self.view, b) {
+        let used = match (self.view, b) {
             (View::Morph, Some(b)) => {
                 let (pa, pb) = (
                     (self.t < 1.0).then(|| plane(Side::A, a)).flatten(),
@@ -460,10 +473,25 @@ impl Job<'_> {
                     warped(b, &pb, &identity),
                     self.t,
                     rows,
-                )
+                );
+                [pa, pb]
             }
-            (View::WarpedB, Some(b)) => show(warped(b, &plane(Side::B, b), &identity), rows),
-            _ => show(warped(a, &plane(Side::A, a), &identity), rows),
+            (View::WarpedB, Some(b)) => {
+                let p = plane(Side::B, b);
+                show(warped(b, &p, &identity), rows);
+                [p, None]
+            }
+            _ => {
+                let p = plane(Side::A, a);
+                show(warped(a, &p, &identity), rows);
+                [p, None]
+            }
+        };
+        let mut kept = pool();
+        for p in used.into_iter().flatten() {
+            if kept.len() < PLANES_KEPT {
+                kept.push(p);
+            }
         }
     }
 }
