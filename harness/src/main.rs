@@ -761,35 +761,47 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
         ],
         "progress": [[1, 0.0], [12, 1.0]]
     });
-    let scene_path = dir.join("demo.morph.json");
-    std::fs::write(
-        &scene_path,
-        serde_json::to_string_pretty(&scene).unwrap_or_default(),
-    )
-    .map_err(|e| HostError::failed(format!("{}: {e}", scene_path.display())))?;
     let s = |p: PathBuf| p.to_string_lossy().into_owned();
-    let job = Job {
-        plugin: MORPH_ID,
-        context: "OfxImageEffectContextGeneral",
-        sources: vec![
-            ("SourceA".into(), s(plates.join("a.exr"))),
-            ("SourceB".into(), s(plates.join("b.exr"))),
-        ],
-        view: "morph".into(),
-        extra: vec![
+    // Writes `scene` to `name.morph.json` and renders frames 1-12 of the morph
+    // of the two plates through it into `output` (plus `extra` views).
+    let render =
+        |name: &str, scene: &serde_json::Value, output: PathBuf, extra: Vec<(String, String)>| {
+            let path = dir.join(format!("{name}.morph.json"));
+            std::fs::write(
+                &path,
+                serde_json::to_string_pretty(scene).unwrap_or_default(),
+            )
+            .map_err(|e| HostError::failed(format!("{}: {e}", path.display())))?;
+            Job {
+                plugin: MORPH_ID,
+                context: "OfxImageEffectContextGeneral",
+                sources: vec![
+                    ("SourceA".into(), s(plates.join("a.exr"))),
+                    ("SourceB".into(), s(plates.join("b.exr"))),
+                ],
+                view: "morph".into(),
+                extra,
+                common: Common {
+                    scene: Some(path),
+                    line: Vec::new(),
+                    t: None,
+                    frames: Some("1-12".into()),
+                    output: s(output),
+                    half: false,
+                },
+            }
+            .run(bundle_path)
+        };
+    render(
+        "demo",
+        &scene,
+        dir.join("morph.####.exr"),
+        vec![
             ("morph".into(), s(dir.join("preview/morph.####.png"))),
             ("stmap-a".into(), s(dir.join("stmap_a.####.exr"))),
         ],
-        common: Common {
-            scene: Some(scene_path.clone()),
-            line: Vec::new(),
-            t: None,
-            frames: Some("1-12".into()),
-            output: s(dir.join("morph.####.exr")),
-            half: false,
-        },
-    };
-    job.run(bundle_path)?;
+    )?;
+    let scene_path = dir.join("demo.morph.json");
 
     // The same morph through the mesh and triangle methods: a 5 × 5 mesh whose
     // inner ring opens from the round face to the square one, and the
@@ -815,31 +827,12 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
     let mut triangles_scene = scene.clone();
     triangles_scene["method"] = "triangles".into();
     for (name, scene) in [("mesh", mesh_scene), ("triangles", triangles_scene)] {
-        let path = dir.join(format!("{name}.morph.json"));
-        std::fs::write(
-            &path,
-            serde_json::to_string_pretty(&scene).unwrap_or_default(),
-        )
-        .map_err(|e| HostError::failed(format!("{}: {e}", path.display())))?;
-        let job = Job {
-            plugin: MORPH_ID,
-            context: "OfxImageEffectContextGeneral",
-            sources: vec![
-                ("SourceA".into(), s(plates.join("a.exr"))),
-                ("SourceB".into(), s(plates.join("b.exr"))),
-            ],
-            view: "morph".into(),
-            extra: Vec::new(),
-            common: Common {
-                scene: Some(path),
-                line: Vec::new(),
-                t: None,
-                frames: Some("1-12".into()),
-                output: s(dir.join(format!("{name}/morph.####.png"))),
-                half: false,
-            },
-        };
-        job.run(bundle_path)?;
+        render(
+            name,
+            &scene,
+            dir.join(format!("{name}/morph.####.png")),
+            Vec::new(),
+        )?;
     }
     println!(
         "MorphFX demo rendered through {}",

@@ -523,19 +523,6 @@ fn mesh_and_triangle_renders_match_the_core_at_every_depth_scale_and_layout() {
     }
 }
 
-/// A plate with a vertical step edge at canonical x = `edge`.
-fn step_plate(bounds: RectI, edge: f64) -> Image {
-    Image::from_fn(bounds, 4, |i, _, c| {
-        if c == 3 {
-            1.0
-        } else if (i as f64 + 0.5) < edge {
-            0.1
-        } else {
-            0.9
-        }
-    })
-}
-
 #[test]
 fn snap_lines_keys_each_side_onto_its_own_edge_at_the_current_frame() {
     let bounds = RectI::new(0, 0, 64, 48);
@@ -543,8 +530,16 @@ fn snap_lines_keys_each_side_onto_its_own_edge_at_the_current_frame() {
         let inst = bundle()
             .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
             .unwrap();
-        let fa = Arc::new(Frame::from_image(&step_plate(bounds, 24.0), depth, false));
-        let fb = Arc::new(Frame::from_image(&step_plate(bounds, 36.0), depth, true));
+        let fa = Arc::new(Frame::from_image(
+            &common::step_plate(bounds, 24.0),
+            depth,
+            false,
+        ));
+        let fb = Arc::new(Frame::from_image(
+            &common::step_plate(bounds, 36.0),
+            depth,
+            true,
+        ));
         inst.connect("SourceA", Arc::new(Still(fa))).unwrap();
         inst.connect("SourceB", Arc::new(Still(fb))).unwrap();
         inst.set_int("line_count", 1).unwrap();

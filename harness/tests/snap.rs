@@ -6,21 +6,12 @@ use std::path::Path;
 mod common;
 
 use morphfx::geom::RectI;
-use morphfx::image::Image;
 use morphfx::scene::Scene;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 
 /// A 96×64 plate with a vertical step edge at canonical x = `edge`.
 fn write_step(path: &Path, edge: f64) {
-    let img = Image::from_fn(RectI::from_size(96, 64), 4, |i, _, c| {
-        if c == 3 {
-            1.0
-        } else if (i as f64 + 0.5) < edge {
-            0.05
-        } else {
-            0.8
-        }
-    });
+    let img = common::step_plate(RectI::from_size(96, 64), edge);
     io::write(
         path,
         &Plate {
