@@ -40,21 +40,15 @@ impl EdgeEnergy {
                 }
             });
         let smooth = gaussian(&lum, w, h, sigma);
-        // Sobel on the smoothed image, squared magnitude.
-        let at = |x: isize, y: isize| {
-            let x = x.clamp(0, w as isize - 1) as usize;
-            let y = y.clamp(0, h as isize - 1) as usize;
-            smooth[y * w + x]
-        };
+        // Sobel on the smoothed image, squared magnitude (edges held).
         let mut p = vec![0f32; w * h];
-        p.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, out)| {
-            let y = y as isize;
+        p.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+            let line = |y: usize| &smooth[y * w..(y + 1) * w];
+            let (lo, mid, hi) = (line(y.saturating_sub(1)), line(y), line((y + 1).min(h - 1)));
             for (x, o) in out.iter_mut().enumerate() {
-                let x = x as isize;
-                let gx = (at(x + 1, y - 1) + 2.0 * at(x + 1, y) + at(x + 1, y + 1))
-                    - (at(x - 1, y - 1) + 2.0 * at(x - 1, y) + at(x - 1, y + 1));
-                let gy = (at(x - 1, y + 1) + 2.0 * at(x, y + 1) + at(x + 1, y + 1))
-                    - (at(x - 1, y - 1) + 2.0 * at(x, y - 1) + at(x + 1, y - 1));
+                let (xl, xr) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                let gx = (lo[xr] + 2.0 * mid[xr] + hi[xr]) - (lo[xl] + 2.0 * mid[xl] + hi[xl]);
+                let gy = (hi[xl] + 2.0 * hi[x] + hi[xr]) - (lo[xl] + 2.0 * lo[x] + lo[xr]);
                 *o = (gx * gx + gy * gy) / 64.0;
             }
         });
@@ -62,17 +56,22 @@ impl EdgeEnergy {
         if max > 0.0 {
             p.iter_mut().for_each(|v| *v /= max);
         }
-        // F = ∇P by central differences.
+        // F = ∇P by central differences (one-sided at the border).
         let (mut fx, mut fy) = (vec![0f32; w * h], vec![0f32; w * h]);
-        for y in 0..h {
-            for x in 0..w {
-                let get = |x: usize, y: usize| p[y * w + x];
-                let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+        fx.par_chunks_mut(w)
+            .zip(fy.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(y, (ox, oy))| {
+                let row = &p[y * w..(y + 1) * w];
                 let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
-                fx[y * w + x] = (get(x1, y) - get(x0, y)) / (x1 - x0).max(1) as f32;
-                fy[y * w + x] = (get(x, y1) - get(x, y0)) / (y1 - y0).max(1) as f32;
-            }
-        }
+                let (below, above) = (&p[y0 * w..(y0 + 1) * w], &p[y1 * w..(y1 + 1) * w]);
+                let dy = (y1 - y0).max(1) as f32;
+                for x in 0..w {
+                    let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                    ox[x] = (row[x1] - row[x0]) / (x1 - x0).max(1) as f32;
+                    oy[x] = (above[x] - below[x]) / dy;
+                }
+            });
         EdgeEnergy { bounds: b, fx, fy }
     }
 
@@ -104,36 +103,42 @@ fn gaussian(src: &[f32], w: usize, h: usize, sigma: f64) -> Vec<f32> {
     if sigma <= 0.0 || w == 0 || h == 0 {
         return src.to_vec();
     }
-    let r = (3.0 * sigma).ceil() as isize;
-    let mut k: Vec<f32> = (-r..=r)
-        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
+    let r = (3.0 * sigma).ceil() as usize;
+    let mut k: Vec<f32> = (0..=2 * r)
+        .map(|i| {
+            let d = i as f64 - r as f64;
+            (-(d * d) / (2.0 * sigma * sigma)).exp() as f32
+        })
         .collect();
     let sum: f32 = k.iter().sum();
     k.iter_mut().for_each(|v| *v /= sum);
+    // Along rows: each row padded with its end values, then a dot product
+    // per pixel.
     let mut tmp = vec![0f32; w * h];
-    tmp.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
-        let row = &src[y * w..(y + 1) * w];
-        for (x, o) in out.iter_mut().enumerate() {
-            *o = k
-                .iter()
-                .enumerate()
-                .map(|(q, kv)| {
-                    kv * row[(x as isize + q as isize - r).clamp(0, w as isize - 1) as usize]
-                })
-                .sum();
-        }
-    });
+    tmp.par_chunks_mut(w)
+        .enumerate()
+        .for_each_init(Vec::new, |padded, (y, out)| {
+            let row = &src[y * w..(y + 1) * w];
+            padded.clear();
+            padded.extend(std::iter::repeat_n(row[0], r));
+            padded.extend_from_slice(row);
+            padded.extend(std::iter::repeat_n(row[w - 1], r));
+            for (x, o) in out.iter_mut().enumerate() {
+                *o = padded[x..x + 2 * r + 1]
+                    .iter()
+                    .zip(&k)
+                    .map(|(v, kv)| v * kv)
+                    .sum();
+            }
+        });
+    // Down columns: whole rows weighted and summed, edges held.
     let mut out = vec![0f32; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, o)| {
-        for (x, v) in o.iter_mut().enumerate() {
-            *v = k
-                .iter()
-                .enumerate()
-                .map(|(q, kv)| {
-                    let yy = (y as isize + q as isize - r).clamp(0, h as isize - 1) as usize;
-                    kv * tmp[yy * w + x]
-                })
-                .sum();
+        for (q, kv) in k.iter().enumerate() {
+            let yy = (y as isize + q as isize - r as isize).clamp(0, h as isize - 1) as usize;
+            for (v, t) in o.iter_mut().zip(&tmp[yy * w..(yy + 1) * w]) {
+                *v += kv * t;
+            }
         }
     });
     out
