@@ -148,38 +148,12 @@ fn main() {
 }
 
 fn run(cli: Cli) -> Result<(), HostError> {
-    // Snap works on the plates with the core's snakes; it needs no bundle.
-    if let Command::Snap {
-        scene,
-        a,
-        b,
-        output,
-        frame,
-        sigma,
-        iterations,
-        clamp_controls,
-    } = &cli.command
-    {
-        let settings = SnakeSettings {
-            iterations: *iterations,
-            clamp_controls: *clamp_controls,
-            ..SnakeSettings::default()
-        };
-        return Snap {
-            scene,
-            a,
-            b,
-            output,
-            frame: *frame,
-            sigma: *sigma,
-            settings,
-        }
-        .run();
-    }
-    let bundle_path = find_bundle(cli.bundle.as_deref())?;
+    // Looked for by the commands that render; `snap` runs the core's snakes
+    // on the plates and needs no bundle.
+    let bundle_path = || find_bundle(cli.bundle.as_deref());
     match cli.command {
         Command::Plugins => {
-            let bundle = Bundle::load(&bundle_path)?;
+            let bundle = Bundle::load(&bundle_path()?)?;
             println!("bundle: {}", bundle.binary.display());
             for p in &bundle.plugins {
                 println!("{}\t{}.{}", p.id, p.version.0, p.version.1);
@@ -220,7 +194,7 @@ fn run(cli: Cli) -> Result<(), HostError> {
                     .collect(),
                 common,
             };
-            job.run(&bundle_path)
+            job.run(&bundle_path()?)
         }
         Command::Warp {
             common,
@@ -238,16 +212,38 @@ fn run(cli: Cli) -> Result<(), HostError> {
                     .unwrap_or_default(),
                 common,
             };
-            job.run(&bundle_path)
+            job.run(&bundle_path()?)
         }
-        Command::Demo { output } => demo(&bundle_path, &output),
-        Command::Snap { .. } => unreachable!("handled before the bundle is looked for"),
+        Command::Demo { output } => demo(&bundle_path()?, &output),
+        Command::Snap {
+            scene,
+            a,
+            b,
+            output,
+            frame,
+            sigma,
+            iterations,
+            clamp_controls,
+        } => Snap {
+            scene: &scene,
+            a: &a,
+            b: &b,
+            output: &output,
+            frame,
+            sigma,
+            settings: SnakeSettings {
+                iterations,
+                clamp_controls,
+                ..SnakeSettings::default()
+            },
+        }
+        .run(),
         Command::Bench {
             output,
             frames,
             width,
             height,
-        } => bench(&bundle_path, &output, frames, (width, height)),
+        } => bench(&bundle_path()?, &output, frames, (width, height)),
     }
 }
 

@@ -320,8 +320,4 @@ impl Plane {
         let start = (j - self.window.y1) as usize * w;
         &self.pixels[start..start + w]
     }
-
-    pub fn memory_bytes(&self) -> usize {
-        self.pixels.len() * std::mem::size_of::<[f32; 4]>()
-    }
 }

@@ -135,17 +135,8 @@ impl<'a, T: Sample> Sampler<'a, T> {
         self.alpha_weighted
     }
 
-    /// Row `j` of the source (inside the bounds) as floats in `out`, one
-    /// pixel per entry in the sampler's layout; colour multiplied by alpha
-    /// when the sampler weights by alpha (straight RGBA), so the row can be
-    /// filtered linearly and divided back afterwards.
-    pub fn load_row(&self, j: i32, out: &mut Vec<[f32; 4]>) {
-        let b = self.view.bounds();
-        self.load_span(j, b.x1, b.width(), out);
-    }
-
     /// Row `j` as it lies in memory when that already is what
-    /// [`Sampler::load_row`] would make (float RGBA, premultiplied): no copy.
+    /// [`Sampler::load_span`] would make (float RGBA, premultiplied): no copy.
     pub fn float_rgba_row(&self, j: i32) -> Option<&'a [[f32; 4]]> {
         if self.view.channels() != 4 || self.alpha_weighted {
             return None;
@@ -153,13 +144,14 @@ impl<'a, T: Sample> Sampler<'a, T> {
         T::as_f32(self.view.row(j)).map(|f| f.as_chunks::<4>().0)
     }
 
-    /// [`Sampler::load_row`] for the `len` pixels from column `i` (inside
-    /// the bounds).
+    /// The `len` pixels of row `j` from column `i` (inside the bounds) as
+    /// floats in `out`, one pixel per entry in the sampler's layout; colour
+    /// multiplied by alpha when the sampler weights by alpha (straight RGBA),
+    /// so the pixels can be filtered linearly and divided back afterwards.
     pub fn load_span(&self, j: i32, i: i32, len: usize, out: &mut Vec<[f32; 4]>) {
         let c = self.view.channels();
         let start = (i - self.view.bounds().x1) as usize * c;
         let row = &self.view.row(j)[start..start + len * c];
-        out.clear();
         match (self.view.channels(), self.alpha_weighted) {
             (4, true) => load::<T, 4, true>(row, out),
             (4, false) => load::<T, 4, false>(row, out),
@@ -403,12 +395,6 @@ fn load<T: Sample, const C: usize, const AW: bool>(row: &[T], out: &mut Vec<[f32
     // Sized first and written in place: `extend` through a mapping iterator
     // does not vectorise.
     out.clear();
-    if C == 4 && !AW {
-        if let Some(floats) = T::as_f32(row) {
-            out.extend_from_slice(floats.as_chunks::<4>().0);
-            return;
-        }
-    }
     out.resize(row.len() / C, [0.0; 4]);
     for (o, px) in out.iter_mut().zip(row.chunks_exact(C)) {
         let mut v = [0f32; 4];

@@ -56,6 +56,8 @@ pub struct Snake {
     pub points: Vec<Vec2>,
     /// Index in `points` of each control point of the primitive.
     pub controls: Vec<usize>,
+    /// Points held still (seed §4.2: "the user may clamp any of the sampled
+    /// points"); set any of them before [`Snake::run`].
     pub clamped: Vec<bool>,
 }
 
@@ -81,11 +83,6 @@ impl Snake {
             controls,
             clamped,
         }
-    }
-
-    /// Holds point `k` still (or frees it).
-    pub fn clamp(&mut self, k: usize, still: bool) {
-        self.clamped[k] = still;
     }
 
     /// `settings.iterations` steps of the minimisation loop on `energy`.

@@ -128,6 +128,18 @@ impl WarpSettings {
     }
 }
 
+impl WarpSettings {
+    /// The mesh pair method `mesh` warps with, or the error that says it is missing.
+    pub fn mesh_pair(&self) -> Result<&MeshPair> {
+        self.meshes.as_ref().ok_or_else(|| {
+            Error::Invalid(
+                "method \"mesh\" needs a mesh: put a \"mesh\" key (rows, cols, a, b) in the scene"
+                    .into(),
+            )
+        })
+    }
+}
+
 /// The warp of the image on `side` toward the features' positions at `t`
 /// (`t = 0`: A's positions, `t = 1`: B's), as a reverse map. For `mesh` this
 /// is the one-pass map; the two-pass warp makes pixels ([`mesh::two_pass`]).
@@ -144,15 +156,7 @@ pub fn toward(
             t,
             &settings.field,
         ))),
-        Method::Mesh => {
-            let pair = settings.meshes.as_ref().ok_or_else(|| {
-                Error::Invalid(
-                    "method \"mesh\" needs a mesh (scene key \"mesh\" with rows, cols, a and b)"
-                        .into(),
-                )
-            })?;
-            Ok(Arc::new(MeshWarp::toward(pair, side, t)))
-        }
+        Method::Mesh => Ok(Arc::new(MeshWarp::toward(settings.mesh_pair()?, side, t))),
         Method::Triangles => {
             let frame = match settings.frame {
                 Some(f) => f,

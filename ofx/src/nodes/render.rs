@@ -262,15 +262,11 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     frame.warp.frame = Some(RectD::new(rod.x1, rod.y1, rod.x2, rod.y2));
     // The two-pass mesh warp makes pixels (per render window), not a map:
     // pictures take that path, ST maps and the grid the one-pass map.
-    let two_pass =
-        match (&frame.warp.method, &frame.warp.meshes) {
-            (Method::Mesh, Some(_)) => frame.warp.mesh.pass == Pass::TwoPass,
-            (Method::Mesh, None) => return Err(Failure::BadInput(
-                "method \"mesh\" needs a mesh: put a \"mesh\" key (rows, cols, a, b) in the scene"
-                    .into(),
-            )),
-            _ => false,
-        };
+    let mesh = frame.warp.method == Method::Mesh;
+    if mesh {
+        frame.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
+    }
+    let two_pass = mesh && frame.warp.mesh.pass == Pass::TwoPass;
     let full = RectI::new(
         (rod.x1 * scale.x).floor() as i32,
         (rod.y1 * scale.y).floor() as i32,
