@@ -2,6 +2,7 @@
 //! to source positions (canonical coordinates), plus dense evaluation over a
 //! window of pixels (DESIGN rule 2).
 
+pub mod auto;
 pub mod field;
 mod map;
 pub mod mesh;
