@@ -1,5 +1,5 @@
 //! Core engine benchmarks: the field map at 1080p, resampling, a whole morph
-//! frame, the mesh warp (two-pass and one-pass) and triangles. Numbers and the machine go in docs/PERFORMANCE.md.
+//! frame, the mesh warp (two-pass and one-pass), triangles, snakes and `auto`. Numbers and the machine go in docs/PERFORMANCE.md.
 //!
 //! `cargo bench --bench core` (add `-- field` etc. to pick a group).
 
@@ -14,6 +14,7 @@ use morphfx::image::resample::{resample, ResampleSettings};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
+use morphfx::warp::auto::{self, AutoSettings, WorkImage};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
 use morphfx::warp::mesh::{self, Mesh, MeshWarp};
 use morphfx::warp::triangles::TriangleWarp;
@@ -269,8 +270,76 @@ fn bench_snakes(c: &mut Criterion) {
     g.finish();
 }
 
+/// A textured plate pair of `w x h` where B is A under a smooth warp of up
+/// to 2% of the frame (the kind of pair `auto` is for).
+fn auto_pair(w: usize, h: usize) -> (WorkImage, WorkImage) {
+    let tex = |x: f64, y: f64| {
+        let (x, y) = (x * 256.0 / w as f64, y * 256.0 / w as f64);
+        [
+            (0.5 + 0.25 * (x / 7.0).sin() * (y / 9.0).cos() + 0.2 * ((x + y) / 13.0).sin()) as f32,
+            (0.5 + 0.3 * ((x - 0.5 * y) / 11.0).cos() + 0.15 * (y / 5.0).sin()) as f32,
+            (0.4 + 0.3 * ((x * x + y * y).sqrt() / 8.0).sin()) as f32,
+        ]
+    };
+    let warp = |x: f64, y: f64| {
+        let (u, v) = (x / w as f64, y / h as f64);
+        let bump = (std::f64::consts::PI * u).sin() * (std::f64::consts::PI * v).sin();
+        let m = 0.02 * w as f64;
+        (
+            x + m * bump * (2.0 * v).cos(),
+            y - m * bump * (3.0 * u).sin(),
+        )
+    };
+    let a = WorkImage::from_fn(w, h, |i, j| tex(i as f64 + 0.5, j as f64 + 0.5));
+    let b = WorkImage::from_fn(w, h, |i, j| {
+        let (x, y) = warp(i as f64 + 0.5, j as f64 + 0.5);
+        tex(x, y)
+    });
+    (a, b)
+}
+
+fn bench_auto(c: &mut Criterion) {
+    let mut g = c.benchmark_group("auto");
+    g.sample_size(10);
+    for (name, w, h) in [("256", 256, 256), ("512", 512, 512), ("1080p", 1920, 1080)] {
+        let (a, b) = auto_pair(w, h);
+        let settings = AutoSettings::default();
+        g.bench_function(format!("solve_{name}"), |bench| {
+            bench.iter(|| {
+                black_box(auto::solve(&a, &b, &[], &settings, auto::Start::Identity).unwrap())
+            })
+        });
+        if name == "1080p" {
+            let first = auto::solve(&a, &b, &[], &settings, auto::Start::Identity).unwrap();
+            g.bench_function("warm_1080p", |bench| {
+                bench.iter(|| {
+                    black_box(
+                        auto::solve(&a, &b, &[], &settings, auto::Start::Warm(&first.grid))
+                            .unwrap(),
+                    )
+                })
+            });
+            let corr = auto::Correspondence::new(
+                first.grid,
+                RectD::new(0.0, 0.0, w as f64, h as f64),
+                RectD::new(0.0, 0.0, w as f64, h as f64),
+            );
+            g.bench_function("map_1080p_t0.5", |bench| {
+                bench.iter(|| {
+                    black_box(
+                        corr.toward(Side::A, 0.5)
+                            .map_window(frame(), PixelScale::UNIT),
+                    )
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    bench_auto,
     bench_snakes,
     bench_field,
     bench_resample,

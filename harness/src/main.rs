@@ -29,6 +29,9 @@ struct Cli {
     /// then the bundle built in this checkout, then /usr/OFX/Plugins.
     #[arg(long, global = true)]
     bundle: Option<PathBuf>,
+    /// Say more while rendering (method auto prints its work table per level).
+    #[arg(short, long, global = true)]
+    verbose: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -138,6 +141,11 @@ enum Command {
 
 fn main() {
     let cli = Cli::parse();
+    if cli.verbose {
+        // The plugin is told through its environment (set before it is
+        // loaded; nothing else runs yet): it prints what it measures to stderr.
+        std::env::set_var("MORPHFX_VERBOSE", "1");
+    }
     match run(cli) {
         Ok(()) => {}
         Err(e) => {

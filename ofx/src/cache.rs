@@ -1,33 +1,54 @@
 //! Warps cached in instance data (DESIGN rule 6): keyed by everything a map
-//! depends on, shared by concurrent renders of the same frame (the second
-//! thread waits for the first instead of computing again), bounded in memory.
+//! (or an `auto` correspondence) depends on, shared by concurrent renders of
+//! the same frame (the second thread waits for the first instead of computing
+//! again), bounded in memory.
 
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 use std::sync::{Arc, Mutex};
 
+use morphfx::warp::auto::Correspondence;
 use morphfx::warp::WarpMap;
 
 /// Default memory budget for cached maps (a 1080p map is 16 MiB).
 pub const DEFAULT_BUDGET_BYTES: usize = 512 << 20;
 
-type Slot = Arc<Mutex<Option<Arc<WarpMap>>>>;
+/// What a cached value costs in memory.
+pub trait Weigh {
+    fn bytes(&self) -> usize;
+}
 
-struct Entry {
+impl Weigh for WarpMap {
+    fn bytes(&self) -> usize {
+        self.memory_bytes()
+    }
+}
+
+impl Weigh for Correspondence {
+    fn bytes(&self) -> usize {
+        self.grid.points().len() * std::mem::size_of::<morphfx::geom::Vec2>()
+    }
+}
+
+type Slot<T> = Arc<Mutex<Option<Arc<T>>>>;
+
+struct Entry<T> {
     key: u64,
-    slot: Slot,
+    slot: Slot<T>,
     bytes: usize,
     last_use: u64,
 }
 
-pub struct WarpCache {
-    entries: Mutex<(Vec<Entry>, u64)>,
+pub struct Cache<T> {
+    entries: Mutex<(Vec<Entry<T>>, u64)>,
     budget: usize,
 }
 
-impl Default for WarpCache {
+pub type WarpCache = Cache<WarpMap>;
+
+impl<T: Weigh> Default for Cache<T> {
     fn default() -> Self {
-        WarpCache::new(DEFAULT_BUDGET_BYTES)
+        Cache::new(DEFAULT_BUDGET_BYTES)
     }
 }
 
@@ -39,9 +60,9 @@ pub fn key_of(parts: &impl std::fmt::Debug) -> u64 {
     h.finish()
 }
 
-impl WarpCache {
+impl<T: Weigh> Cache<T> {
     pub fn new(budget: usize) -> Self {
-        WarpCache {
+        Cache {
             entries: Mutex::new((Vec::new(), 0)),
             budget,
         }
@@ -50,8 +71,8 @@ impl WarpCache {
     pub fn get_or_compute<E>(
         &self,
         key: u64,
-        compute: impl FnOnce() -> Result<WarpMap, E>,
-    ) -> Result<Arc<WarpMap>, E> {
+        compute: impl FnOnce() -> Result<T, E>,
+    ) -> Result<Arc<T>, E> {
         let slot = {
             let mut guard = self.entries.lock().unwrap_or_else(|e| e.into_inner());
             let (entries, clock) = &mut *guard;
@@ -62,7 +83,7 @@ impl WarpCache {
                     e.slot.clone()
                 }
                 None => {
-                    let slot: Slot = Arc::default();
+                    let slot: Slot<T> = Arc::new(Mutex::new(None));
                     entries.push(Entry {
                         key,
                         slot: slot.clone(),
@@ -81,7 +102,7 @@ impl WarpCache {
         let map = Arc::new(compute()?);
         *value = Some(map.clone());
         drop(value);
-        self.account(key, map.memory_bytes());
+        self.account(key, map.bytes());
         Ok(map)
     }
 

@@ -6,6 +6,7 @@ mod parse;
 mod tests;
 
 use crate::features::{Feature, DEFAULT_SAMPLES_PER_SEGMENT};
+use crate::warp::auto::AutoSettings;
 use crate::warp::field::FieldSettings;
 use crate::warp::mesh::{MeshPair, MeshSettings};
 
@@ -54,7 +55,10 @@ impl Method {
     /// Whether this build can render the method. The others are accepted in
     /// scenes (so files stay valid) but refuse to render with a clear message.
     pub fn is_available(self) -> bool {
-        matches!(self, Method::Field | Method::Mesh | Method::Triangles)
+        matches!(
+            self,
+            Method::Field | Method::Mesh | Method::Triangles | Method::Auto
+        )
     }
 
     /// The methods this build renders, for messages: `field, mesh, ...`.
@@ -90,6 +94,8 @@ pub struct Scene {
     /// The mesh pair: one static pair, or pairs keyed at frames (sorted,
     /// strictly increasing), interpolated like feature keyframes.
     pub meshes: Vec<(f64, MeshPair)>,
+    /// Settings of `auto` (scene key `auto`).
+    pub auto: AutoSettings,
     /// Samples per polyline/curve span for point-based methods (seed 000 §4.2).
     pub samples_per_segment: usize,
     /// The features when there are no keyframes.
@@ -110,6 +116,7 @@ impl Default for Scene {
             field: FieldSettings::default(),
             mesh: MeshSettings::default(),
             meshes: Vec::new(),
+            auto: AutoSettings::default(),
             samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
             features: Vec::new(),
             keyframes: Vec::new(),

@@ -8,6 +8,8 @@ use super::{Keyframe, Method, Scene};
 use crate::error::{Error, Result};
 use crate::features::{Feature, FeatureKind};
 use crate::geom::Vec2;
+use crate::warp::auto::grid::MAX_LEVEL;
+use crate::warp::auto::{AutoSettings, Coefficients, Grid};
 use crate::warp::field::{Evaluation, FieldSettings, LineInterpolation};
 use crate::warp::mesh::{Mesh, MeshPair, MeshSettings, Pass};
 
@@ -21,6 +23,7 @@ struct RawScene {
     field: Option<RawField>,
     sampling: Option<RawSampling>,
     mesh: Option<RawMesh>,
+    auto: Option<RawAuto>,
     features: Option<Vec<RawFeature>>,
     keyframes: Option<Vec<RawKeyframe>>,
     progress: Option<Vec<[f64; 2]>>,
@@ -63,6 +66,19 @@ struct RawMeshKey {
     frame: f64,
     a: Vec<[f64; 2]>,
     b: Vec<[f64; 2]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAuto {
+    levels: Option<u32>,
+    colour: Option<f64>,
+    stretch: Option<f64>,
+    angle: Option<f64>,
+    anchors: Option<f64>,
+    warm_start: Option<bool>,
+    warm_iterations: Option<usize>,
+    initial: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Deserialize)]
@@ -140,6 +156,10 @@ impl Scene {
                 "method \"mesh\" needs a mesh: {\"rows\": R, \"cols\": C, \"a\": [...], \"b\": [...]}",
             ));
         }
+        let auto = match raw.auto {
+            Some(a) => auto_settings(a)?,
+            None => AutoSettings::default(),
+        };
         let features = match raw.features {
             Some(list) => features(list, "")?,
             None => Vec::new(),
@@ -157,6 +177,7 @@ impl Scene {
             field,
             mesh,
             meshes,
+            auto,
             samples_per_segment,
             features,
             keyframes,
@@ -174,6 +195,65 @@ impl Scene {
         }
         Ok(scene)
     }
+}
+
+/// The `auto` key: each number in its range, the initial warp a legal grid.
+fn auto_settings(raw: RawAuto) -> Result<AutoSettings> {
+    let d = AutoSettings::default();
+    let weight = |v: Option<f64>, default: f64, key: &str| -> Result<f64> {
+        match v {
+            None => Ok(default),
+            Some(x) if x.is_finite() && (0.0..=1000.0).contains(&x) => Ok(x),
+            Some(x) => Err(Error::scene(
+                format!("auto.{key}"),
+                format!("{x} is out of range: 0 to 1000"),
+            )),
+        }
+    };
+    let levels = match raw.levels {
+        None => None,
+        Some(l) if (1..=MAX_LEVEL).contains(&l) => Some(l),
+        Some(l) => {
+            return Err(Error::scene(
+                "auto.levels",
+                format!("{l} is out of range: 1 to {MAX_LEVEL}"),
+            ))
+        }
+    };
+    let warm_iterations = match raw.warm_iterations {
+        None => d.warm_iterations,
+        Some(n) if (1..=10).contains(&n) => n,
+        Some(n) => {
+            return Err(Error::scene(
+                "auto.warm_iterations",
+                format!("{n} is out of range: 1 to 10"),
+            ))
+        }
+    };
+    let initial = match raw.initial {
+        None => None,
+        Some(pts) => {
+            let pts: Vec<Vec2> = pts.into_iter().map(Vec2::from).collect();
+            // Convexity does not change under the frame's (positive) scaling,
+            // so the grid can be checked in pixels, before any frame is known.
+            Grid::from_points(pts.clone())
+                .map_err(|e| Error::scene("auto.initial", e.to_string()))?;
+            Some(pts)
+        }
+    };
+    let c = d.coefficients;
+    Ok(AutoSettings {
+        levels,
+        coefficients: Coefficients {
+            colour: weight(raw.colour, c.colour, "colour")?,
+            stretch: weight(raw.stretch, c.stretch, "stretch")?,
+            angle: weight(raw.angle, c.angle, "angle")?,
+            anchor: weight(raw.anchors, c.anchor, "anchors")?,
+        },
+        warm_start: raw.warm_start.unwrap_or(d.warm_start),
+        warm_iterations,
+        initial,
+    })
 }
 
 fn field_settings(raw: RawField) -> Result<FieldSettings> {

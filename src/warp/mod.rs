@@ -82,6 +82,7 @@ use crate::error::{Error, Result};
 use crate::features::{Feature, Side, DEFAULT_SAMPLES_PER_SEGMENT};
 use crate::geom::RectD;
 use crate::scene::{Method, Scene};
+use auto::{AutoSettings, Correspondence};
 use field::{FieldSettings, FieldWarp};
 use mesh::{MeshPair, MeshSettings, MeshWarp};
 use triangles::TriangleWarp;
@@ -100,6 +101,10 @@ pub struct WarpSettings {
     /// The frame (canonical) whose border `triangles` pins; without it, the
     /// features' bounds grown by half their size on each side.
     pub frame: Option<RectD>,
+    pub auto: AutoSettings,
+    /// The correspondence `auto` solved for this frame from both images
+    /// ([`auto::correspond`]); the warps only read it.
+    pub correspondence: Option<Arc<Correspondence>>,
 }
 
 impl Default for WarpSettings {
@@ -111,6 +116,8 @@ impl Default for WarpSettings {
             samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
             meshes: None,
             frame: None,
+            auto: AutoSettings::default(),
+            correspondence: None,
         }
     }
 }
@@ -125,6 +132,8 @@ impl WarpSettings {
             samples_per_segment: s.samples_per_segment,
             meshes: s.mesh_at(frame),
             frame: None,
+            auto: s.auto.clone(),
+            correspondence: None,
         }
     }
 }
@@ -172,6 +181,14 @@ pub fn toward(
                 settings.samples_per_segment,
                 frame,
             )?))
+        }
+        Method::Auto => {
+            let c = settings.correspondence.as_ref().ok_or_else(|| {
+                Error::Invalid(
+                    "method \"auto\" needs both images: its correspondence is solved from A and B (the Morph node, morphfx morph)".into(),
+                )
+            })?;
+            Ok(Arc::new(c.toward(side, t)))
         }
         m => Err(Error::Unsupported(format!(
             "method \"{}\" is not available in this build yet (available: {})",

@@ -5,8 +5,9 @@ use std::sync::{Arc, Mutex};
 
 use morphfx::image::Plane;
 use morphfx::scene::Scene;
+use morphfx::warp::auto::{Correspondence, Grid};
 
-use crate::cache::WarpCache;
+use crate::cache::{Cache, WarpCache};
 use crate::wrapper::clips::Effect;
 use crate::wrapper::{dispatch, Outcome};
 
@@ -20,7 +21,15 @@ pub struct Instance {
     /// Two-pass output planes kept between renders (at most [`PLANES_KEPT`]):
     /// fresh frame-sized memory costs more than a tenth of a two-pass warp.
     pub planes: Mutex<Vec<Plane>>,
+    /// `auto` correspondences, keyed by the images' content and the settings.
+    pub correspondences: Cache<Correspondence>,
+    /// The last solved `auto` grids by frame, for warm starts: `(time,
+    /// settings key, grid)`, at most [`GRIDS_KEPT`].
+    pub grids: Mutex<Vec<(f64, u64, Grid)>>,
 }
+
+/// Solved grids kept for warm starts.
+pub const GRIDS_KEPT: usize = 8;
 
 /// A morph needs two planes.
 pub const PLANES_KEPT: usize = 2;
@@ -33,6 +42,8 @@ impl Instance {
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .clear();
+        self.correspondences.clear();
+        self.grids.lock().unwrap_or_else(|e| e.into_inner()).clear();
     }
 
     /// True the first time `what` is asked about.

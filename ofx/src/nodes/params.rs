@@ -5,6 +5,8 @@ use morphfx::geom::Vec2;
 use morphfx::image::{EdgeMode, Filter};
 use morphfx::scene::Method;
 use morphfx::views::View;
+use morphfx::warp::auto::grid::MAX_LEVEL;
+use morphfx::warp::auto::{AutoSettings, Coefficients};
 use morphfx::warp::field::{Evaluation, FieldSettings, LineInterpolation};
 use morphfx::warp::mesh::{MeshSettings, Pass};
 
@@ -36,6 +38,12 @@ pub const VIEW: &str = "view";
 pub const MESH_PASS: &str = "mesh_pass";
 pub const SNAP_LINES: &str = "snap_lines";
 pub const SNAP_SIGMA: &str = "snap_sigma";
+pub const AUTO_LEVELS: &str = "auto_levels";
+pub const AUTO_COLOUR: &str = "auto_colour";
+pub const AUTO_STRETCH: &str = "auto_stretch";
+pub const AUTO_ANGLE: &str = "auto_angle";
+pub const AUTO_ANCHORS: &str = "auto_anchors";
+pub const AUTO_WARM_START: &str = "auto_warm_start";
 
 /// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
 pub fn slot_ids(k: usize) -> [String; 5] {
@@ -58,7 +66,7 @@ fn method_options() -> Vec<&'static str> {
             Method::ThinPlate => "thin-plate (not yet available)",
             Method::Mffd => "mffd (not yet available)",
             Method::Hybrid => "hybrid (not yet available)",
-            Method::Auto => "auto (not yet available)",
+            Method::Auto => "auto",
         })
         .collect()
 }
@@ -81,8 +89,9 @@ fn view_label(kind: NodeKind, v: View) -> &'static str {
 
 pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
     let d = FieldSettings::default();
+    let c = Coefficients::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine. Methods marked not yet available refuse to render.", Kind::Choice { options: method_options(), default: 0 }),
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; auto: the least-work warp of A onto B found from the images (Morph node only), features acting as anchors. Methods marked not yet available refuse to render.", Kind::Choice { options: method_options(), default: 0 }),
         ParamSpec::new(
             PROGRESS,
             "Progress",
@@ -100,6 +109,13 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(TOLERANCE, "Tolerance", "Largest error of the adaptive evaluation, in pixels.", Kind::Double { default: Evaluation::DEFAULT_TOLERANCE, min: 0.001, max: 5.0, display: (0.01, 1.0) }).in_group("field_group").animated(false),
         ParamSpec::new("mesh_group", "Mesh", "Mesh warp (the mesh comes from the scene's \"mesh\" key)", Kind::Group { open: false }),
         ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", Kind::Choice { options: vec!["two-pass", "one-pass"], default: 0 }).in_group("mesh_group").animated(false),
+        ParamSpec::new("auto_group", "Auto", "Automatic correspondence by work minimisation (method auto)", Kind::Group { open: false }),
+        ParamSpec::new(AUTO_LEVELS, "Levels", "Depth of the search: 2^levels quads per side. 0: quads of about 4 pixels (6 at 256, 8 at HD). Fewer levels are faster and coarser.", Kind::Int { default: 0, min: 0, max: MAX_LEVEL as i32 }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_COLOUR, "Colour Work", "Weight of re-colouring work (c_c): how hard the warp tries to match B's colours.", Kind::Double { default: c.colour, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_STRETCH, "Stretch Work", "Weight of stretching work (c_s). 0 with Angle Work 0 gives a more fluid warp.", Kind::Double { default: c.stretch, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_ANGLE, "Angle Work", "Weight of angle-change work (c_a).", Kind::Double { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_ANCHORS, "Anchor Weight", "How strongly features (line slots, scene features) hold as anchor points.", Kind::Double { default: c.anchor, min: 0.0, max: 1000.0, display: (0.0, 100.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_WARM_START, "Warm Start", "Start each frame from the previous frame's warp when this instance has it: faster, steadier over a sequence; off makes every frame independent of render order.", Kind::Bool { default: true }).in_group("auto_group").animated(false),
         ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
         ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
@@ -237,6 +253,7 @@ pub struct Settings {
     pub settings_from_scene: bool,
     pub field: FieldSettings,
     pub mesh: MeshSettings,
+    pub auto: AutoSettings,
     pub lines: Vec<Feature>,
     pub scene_file: String,
     pub scene_text: String,
@@ -288,6 +305,22 @@ impl Settings {
             Pass::OnePass
         } else {
             Pass::TwoPass
+        };
+        let c = Coefficients::default();
+        let weight = |id: &str, d: f64| f64_or(id, d).clamp(0.0, 1000.0);
+        let auto = AutoSettings {
+            levels: match int_or(AUTO_LEVELS, 0) {
+                l if l <= 0 => None,
+                l => Some((l as u32).min(MAX_LEVEL)),
+            },
+            coefficients: Coefficients {
+                colour: weight(AUTO_COLOUR, c.colour),
+                stretch: weight(AUTO_STRETCH, c.stretch),
+                angle: weight(AUTO_ANGLE, c.angle),
+                anchor: weight(AUTO_ANCHORS, c.anchor),
+            },
+            warm_start: int_or(AUTO_WARM_START, 1) != 0,
+            ..AutoSettings::default()
         };
         let count = int_or(LINE_COUNT, 0).clamp(0, LINE_SLOTS as i32) as usize;
         let offset_a = int_or(OFFSET_A, 0);
@@ -344,6 +377,7 @@ impl Settings {
                 curve_samples: d.curve_samples,
             },
             mesh: MeshSettings { pass },
+            auto,
             lines,
             scene_file,
             scene_text,

@@ -10,19 +10,40 @@ use morphfx::image::{ImageView, Plane, RowsMut, Sample, Sampler};
 use morphfx::morph::{dissolve, show, Warped};
 use morphfx::scene::{Method, Scene};
 use morphfx::views::{self, View};
+use morphfx::warp::auto::{self, Correspondence, WorkImage};
 use morphfx::warp::mesh::{self, MeshPair, Pass};
 use morphfx::warp::{self, WarpMap, WarpSettings};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::message::*;
 
-use super::instance::{self, Instance, PLANES_KEPT};
+use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT};
 use super::params::{Settings, OFFSET_A, OFFSET_B};
 use super::NodeKind;
 use crate::cache::key_of;
 use crate::wrapper::clips::{Clip, Depth, Effect, HostImage};
 use crate::wrapper::props::PropSet;
 use crate::wrapper::{Failure, Outcome};
+
+/// `$body` with `$T` the Rust type of a host bit depth.
+macro_rules! with_depth {
+    ($depth:expr, $T:ident => $body:expr) => {
+        match $depth {
+            Depth::U8 => {
+                type $T = u8;
+                $body
+            }
+            Depth::U16 => {
+                type $T = u16;
+                $body
+            }
+            Depth::F32 => {
+                type $T = f32;
+                $body
+            }
+        }
+    };
+}
 
 const TRANSITION: &str = "OfxImageEffectContextTransition";
 
@@ -180,6 +201,7 @@ fn frame_at(
         method: settings.method,
         field: settings.field,
         mesh: settings.mesh,
+        auto: settings.auto.clone(),
         ..WarpSettings::default()
     };
     let mut t = settings.progress;
@@ -250,6 +272,33 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     let a_info = a_img.info()?;
     let b_info = b_img.as_ref().map(|b| b.info()).transpose()?;
 
+    let a_scale = PixelScale::new(a_info.render_scale.0, a_info.render_scale.1, a_info.par);
+    let b_scale = b_info.map(|b| PixelScale::new(b.render_scale.0, b.render_scale.1, b.par));
+    if frame.warp.method == Method::Auto {
+        let (Some(b_img), Some(b_info), Some(b_scale)) = (&b_img, &b_info, b_scale) else {
+            return Err(Failure::BadInput(
+                "method \"auto\" finds its warp from two images: use the Morph node (this node has one source)".into(),
+            ));
+        };
+        if b_info.depth != a_info.depth {
+            return Err(Failure::BadInput(
+                "Source A and Source B have different bit depths".into(),
+            ));
+        }
+        let (a_work, b_work) = with_depth!(a_info.depth, S => (
+            WorkImage::from_view(&a_img.view::<S>(&a_info)?),
+            WorkImage::from_view(&b_img.view::<S>(b_info)?),
+        ));
+        let a_frame = canonical(a_info.bounds, a_scale);
+        let b_frame = canonical(b_info.bounds, b_scale);
+        frame.warp.correspondence = Some(correspondence(
+            &instance,
+            &frame,
+            time,
+            (&a_work, a_frame),
+            (&b_work, b_frame),
+        )?);
+    }
     let scale = PixelScale::new(
         out_info.render_scale.0,
         out_info.render_scale.1,
@@ -311,27 +360,6 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         origin,
         size,
     };
-    let a_scale = PixelScale::new(a_info.render_scale.0, a_info.render_scale.1, a_info.par);
-    let b_scale = b_info.map(|b| PixelScale::new(b.render_scale.0, b.render_scale.1, b.par));
-
-    macro_rules! with_depth {
-        ($depth:expr, $T:ident => $body:expr) => {
-            match $depth {
-                Depth::U8 => {
-                    type $T = u8;
-                    $body
-                }
-                Depth::U16 => {
-                    type $T = u16;
-                    $body
-                }
-                Depth::F32 => {
-                    type $T = f32;
-                    $body
-                }
-            }
-        };
-    }
     with_depth!(out_info.depth, D => {
         let rows = out_img.rows_mut::<D>(&out_info, window)?;
         with_depth!(a_info.depth, S => {
@@ -351,6 +379,85 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         })
     });
     Ok(())
+}
+
+/// The canonical rectangle a host image's pixels cover.
+fn canonical(bounds: RectI, scale: PixelScale) -> RectD {
+    RectD::new(
+        bounds.x1 as f64 / scale.x,
+        bounds.y1 as f64 / scale.y,
+        bounds.x2 as f64 / scale.x,
+        bounds.y2 as f64 / scale.y,
+    )
+}
+
+/// The frame's `auto` correspondence: solved once per content of the two
+/// images and settings (tiles and repeated renders share it), warm-started
+/// from the previous frame's grid when this instance solved it.
+fn correspondence(
+    instance: &Instance,
+    frame: &Frame,
+    time: f64,
+    (a, a_frame): (&WorkImage, RectD),
+    (b, b_frame): (&WorkImage, RectD),
+) -> Outcome<Arc<Correspondence>> {
+    let settings = &frame.warp.auto;
+    let per_segment = frame.warp.samples_per_segment;
+    let same_setup = key_of(&(
+        settings,
+        per_segment,
+        a_frame,
+        b_frame,
+        a.width,
+        a.height,
+        b.width,
+        b.height,
+    ));
+    let key = key_of(&(same_setup, a.digest(), b.digest(), &frame.features));
+    instance.correspondences.get_or_compute(key, || {
+        let warm = {
+            let grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+            grids
+                .iter()
+                .find(|(t, k, _)| *t == time - 1.0 && *k == same_setup)
+                .map(|(_, _, g)| g.clone())
+        };
+        let started = std::time::Instant::now();
+        let (c, table) = auto::correspond(
+            a,
+            a_frame,
+            b,
+            b_frame,
+            &frame.features,
+            per_segment,
+            settings,
+            warm.as_ref(),
+        )
+        .map_err(|e| Failure::BadInput(e.to_string()))?;
+        if std::env::var_os("MORPHFX_VERBOSE").is_some() {
+            eprintln!(
+                "auto: frame {time}: {}x{} to {}x{}, {} start, {:.2} s\n{}",
+                a.width,
+                a.height,
+                b.width,
+                b.height,
+                if warm.is_some() && settings.warm_start {
+                    "warm"
+                } else {
+                    "cold"
+                },
+                started.elapsed().as_secs_f64(),
+                auto::table_text(&table)
+            );
+        }
+        let mut grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+        grids.retain(|(t, k, _)| !(*t == time && *k == same_setup));
+        if grids.len() >= GRIDS_KEPT {
+            grids.remove(0);
+        }
+        grids.push((time, same_setup, c.grid.clone()));
+        Ok(c)
+    })
 }
 
 fn needs_a(view: View) -> bool {

@@ -47,7 +47,7 @@ impl Default for AutoSettings {
             levels: None,
             coefficients: Coefficients::default(),
             warm_start: true,
-            warm_iterations: 2,
+            warm_iterations: 3,
             initial: None,
         }
     }
