@@ -26,7 +26,7 @@ impl Weigh for WarpMap {
 
 impl Weigh for Correspondence {
     fn bytes(&self) -> usize {
-        self.grid.points().len() * std::mem::size_of::<morphfx::geom::Vec2>()
+        std::mem::size_of_val(self.grid.points())
     }
 }
 
