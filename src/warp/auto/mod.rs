@@ -59,6 +59,9 @@ pub fn default_levels(width: usize, height: usize) -> u32 {
     ((r / 4.0).log2().floor() as u32).clamp(1, grid::MAX_LEVEL)
 }
 
+/// Pixels a quad spans, at least, in the plate its work is priced on.
+const QUAD_SAMPLES: f64 = 32.0;
+
 /// Where the search starts.
 #[derive(Debug, Clone)]
 pub enum Start<'a> {
@@ -117,6 +120,16 @@ pub fn solve(
     let top = top.max(grid.level());
     let c = &settings.coefficients;
     let first = grid.level().max(1);
+    // The search at coarse levels prices quads on halved plates, so that a
+    // quad spans about `QUAD_SAMPLES` pixels or more (a coarse-to-fine
+    // pyramid: big quads need no per-pixel detail, and blur smooths the
+    // work's landscape). The table reports full-resolution work.
+    let (pa, pb) = (a.clone().pyramid(8), b.clone().pyramid(8));
+    let pick = |pyr: &'_ [WorkImage], level: u32| -> usize {
+        let quad = pyr[0].width.min(pyr[0].height) as f64 / (1u64 << level) as f64;
+        let k = (quad / QUAD_SAMPLES).log2().floor().max(0.0) as usize;
+        k.min(pyr.len() - 1)
+    };
     let mut table = vec![LevelWork {
         level: 0,
         work: Pricer::new(a, b, first, anchors, c)
@@ -135,8 +148,14 @@ pub fn solve(
                 "auto: the initial warp cannot be pulled onto the frame without folding".into(),
             ));
         }
-        let pricer = Pricer::new(a, b, level, anchors, c);
-        let mut works = pricer.all(&grid);
+        let search = Pricer::new(
+            &pa[pick(&pa, level)],
+            &pb[pick(&pb, level)],
+            level,
+            anchors,
+            c,
+        );
+        let mut works = search.all(&grid);
         let iterations = if warm {
             settings.warm_iterations
         } else if level == top {
@@ -146,10 +165,13 @@ pub fn solve(
         } else {
             optimise::iterations(level)
         };
-        optimise::refine_level(&mut grid, &pricer, &mut works, iterations);
+        optimise::refine_level(&mut grid, &search, &mut works, iterations);
         table.push(LevelWork {
             level,
-            work: works.into_iter().sum(),
+            work: Pricer::new(a, b, level, anchors, c)
+                .all(&grid)
+                .into_iter()
+                .sum(),
         });
     }
     Ok(Solution { grid, table })

@@ -157,13 +157,8 @@ fn search_point(
             if !trial.iter().all(super::grid::is_convex_ccw) {
                 continue;
             }
-            let priced: Vec<Work> = quads
-                .iter()
-                .zip(&trial)
-                .map(|(&(qj, qk, _), q)| pricer.quad(qj, qk, q))
-                .collect();
-            let total: f64 = priced.iter().map(Work::total).sum();
-            if total < cost && best.as_ref().is_none_or(|b| total < b.0) {
+            let bound = best.as_ref().map_or(cost, |b| b.0.min(cost));
+            if let Some((total, priced)) = price(pricer, &quads, &trial, bound) {
                 best = Some((total, candidate, priced));
             }
         }
@@ -185,6 +180,34 @@ fn search_point(
             .collect();
         (at, updates)
     })
+}
+
+/// The work of the quads `trial` if it is below `bound`; `None` as soon as
+/// it cannot be (colour, the costly part, is priced last and quad by quad,
+/// and work is never negative).
+fn price(
+    pricer: &Pricer<'_>,
+    quads: &[(usize, usize, usize)],
+    trial: &[[Vec2; 4]],
+    bound: f64,
+) -> Option<(f64, Vec<Work>)> {
+    let mut priced: Vec<Work> = quads
+        .iter()
+        .zip(trial)
+        .map(|(&(qj, qk, _), q)| pricer.shape_work(qj, qk, q))
+        .collect();
+    let mut total: f64 = priced.iter().map(Work::total).sum();
+    if total >= bound {
+        return None;
+    }
+    for (w, (&(qj, qk, _), q)) in priced.iter_mut().zip(quads.iter().zip(trial)) {
+        w.colour = pricer.colour_work(qj, qk, q);
+        total += w.colour;
+        if total >= bound {
+            return None;
+        }
+    }
+    Some((total, priced))
 }
 
 /// The current warp at unit position `u`, which lies in one of the quads

@@ -63,6 +63,40 @@ impl WorkImage {
         }
     }
 
+    /// Half the size, each pixel the mean of the (up to) four it covers.
+    pub fn half(&self) -> WorkImage {
+        let (w, h) = (self.width.div_ceil(2), self.height.div_ceil(2));
+        let mut pixels = Vec::with_capacity(w * h);
+        for j in 0..h {
+            let (j0, j1) = (2 * j, (2 * j + 1).min(self.height - 1));
+            for i in 0..w {
+                let (i0, i1) = (2 * i, (2 * i + 1).min(self.width - 1));
+                let p = |i: usize, j: usize| wide::f32x4::new(self.pixels[j * self.width + i]);
+                let mean = (p(i0, j0) + p(i1, j0) + p(i0, j1) + p(i1, j1)) * 0.25;
+                pixels.push(mean.to_array());
+            }
+        }
+        WorkImage {
+            width: w,
+            height: h,
+            pixels,
+        }
+    }
+
+    /// This image and its halvings while the smaller side keeps at least
+    /// `min_side` pixels.
+    pub fn pyramid(self, min_side: usize) -> Vec<WorkImage> {
+        let mut levels = vec![self];
+        loop {
+            let last = levels.last().expect("one level");
+            if last.width.min(last.height) / 2 < min_side {
+                return levels;
+            }
+            let next = last.half();
+            levels.push(next);
+        }
+    }
+
     #[inline]
     pub fn pixel(&self, i: usize, j: usize) -> [f32; 4] {
         self.pixels[j * self.width + i]
@@ -257,11 +291,27 @@ impl<'a> Pricer<'a> {
     /// The work of quad `(j, k)` when its corners are `q`.
     pub fn quad(&self, j: usize, k: usize, q: &[Vec2; 4]) -> Work {
         Work {
-            colour: self.colour * self.recolour(j, k, q),
+            colour: self.colour_work(j, k, q),
+            ..self.shape_work(j, k, q)
+        }
+    }
+
+    /// The cheap part of [`Pricer::quad`]: all but the colour.
+    pub fn shape_work(&self, j: usize, k: usize, q: &[Vec2; 4]) -> Work {
+        Work {
+            colour: 0.0,
             stretch: self.stretch * stretch(q, 1.0 / self.n as f64),
             angle: self.angle * angle(q),
             anchor: self.anchor * self.anchors(j, k, q),
         }
+    }
+
+    /// The colour part of [`Pricer::quad`] (the cost of the search).
+    pub fn colour_work(&self, j: usize, k: usize, q: &[Vec2; 4]) -> f64 {
+        if self.colour == 0.0 {
+            return 0.0;
+        }
+        self.colour * self.recolour(j, k, q)
     }
 
     /// Eq. (6): every A pixel whose centre lies in the quad, against B's
