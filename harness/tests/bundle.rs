@@ -12,6 +12,7 @@ use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
+use morphfx::warp::auto::{self, AutoSettings, WorkImage};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp};
 use morphfx::warp::mesh::{two_pass, Mesh, MeshPair};
 use morphfx::warp::triangles::TriangleWarp;
@@ -76,6 +77,8 @@ enum Method {
     Mesh,
     /// The scene text's features, triangulated.
     Triangles,
+    /// Found from the two sources (work minimisation).
+    Auto,
 }
 
 /// A 4 × 4 mesh on `bounds` (canonical at full resolution), its inner
@@ -111,6 +114,7 @@ fn points_json(points: &[Vec2]) -> String {
 fn scene_text(case: &Case) -> String {
     match case.method {
         Method::Field => String::new(),
+        Method::Auto => r#"{"method": "auto"}"#.into(),
         Method::Mesh => {
             let pair = mesh_pair(case.bounds);
             format!(
@@ -244,7 +248,35 @@ fn expected(case: &Case, a: &Image, b: &Image) -> Image {
         case.bounds.x2 as f64,
         case.bounds.y2 as f64,
     );
+    let correspondence = (case.method == Method::Auto).then(|| {
+        let canonical = |im: &Image| {
+            let r = im.bounds;
+            RectD::new(
+                r.x1 as f64 / case.scale,
+                r.y1 as f64 / case.scale,
+                r.x2 as f64 / case.scale,
+                r.y2 as f64 / case.scale,
+            )
+        };
+        auto::correspond(
+            &WorkImage::from_view(&a.view()),
+            canonical(a),
+            &WorkImage::from_view(&b.view()),
+            canonical(b),
+            &[],
+            20,
+            &AutoSettings::default(),
+            None,
+        )
+        .unwrap()
+        .0
+    });
     let map = |side: Side| match case.method {
+        Method::Auto => correspondence
+            .as_ref()
+            .expect("solved")
+            .toward(side, T)
+            .map_window(full, scale),
         Method::Triangles => TriangleWarp::toward(&f, side, T, 20, frame)
             .unwrap()
             .map_window(full, scale),
@@ -483,8 +515,8 @@ fn eight_concurrent_tiles_equal_the_serial_render() {
 }
 
 #[test]
-fn mesh_and_triangle_renders_match_the_core_at_every_depth_scale_and_layout() {
-    for method in [Method::Mesh, Method::Triangles] {
+fn mesh_triangle_and_auto_renders_match_the_core_at_every_depth_scale_and_layout() {
+    for method in [Method::Mesh, Method::Triangles, Method::Auto] {
         for depth in DEPTHS {
             for scale in [1.0, 0.5] {
                 check(Case {

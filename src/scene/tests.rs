@@ -134,10 +134,81 @@ fn refuses_each_kind_of_bad_scene_naming_the_culprit() {
 }
 
 #[test]
-fn unknown_methods_settings_are_kept() {
-    let s = Scene::parse(r#"{"method": "auto", "auto": {"levels": 4}}"#).unwrap();
+fn settings_of_methods_to_come_are_kept() {
+    let text = r#"{"method": "field", "features": [{"type": "point", "a": [[1, 2]], "b": [[3, 4]]}], "thin-plate": {"alpha": 4}}"#;
+    let s = Scene::parse(text).unwrap();
+    assert!(s.extra.contains_key("thin-plate"));
+}
+
+#[test]
+fn auto_settings_are_read_and_checked() {
+    let s = Scene::parse(
+        r#"{"method": "auto", "auto": {"levels": 4, "colour": 2, "stretch": 0, "angle": 0.5, "anchors": 30,
+            "warm_start": false, "initial": [[0,0],[50,0],[100,0],[0,50],[60,45],[100,50],[0,100],[50,100],[100,100]]}}"#,
+    )
+    .unwrap();
     assert_eq!(s.method, Method::Auto);
-    assert!(s.extra.contains_key("auto"));
+    let a = &s.auto;
+    assert_eq!(a.levels, Some(4));
+    assert_eq!(
+        (
+            a.coefficients.colour,
+            a.coefficients.stretch,
+            a.coefficients.angle,
+            a.coefficients.anchor
+        ),
+        (2.0, 0.0, 0.5, 30.0)
+    );
+    assert!(!a.warm_start);
+    assert_eq!(
+        a.initial.as_ref().map(|p| p[4]),
+        Some(crate::geom::Vec2::new(60.0, 45.0))
+    );
+    // No features needed: auto finds its own correspondence.
+    assert!(Scene::parse(r#"{"method": "auto"}"#).is_ok());
+    let cases = [
+        (
+            r#"{"method": "auto", "auto": {"levels": 0}}"#,
+            "auto.levels",
+            "out of range",
+        ),
+        (
+            r#"{"method": "auto", "auto": {"stretch": -1}}"#,
+            "auto.stretch",
+            "out of range",
+        ),
+        (
+            r#"{"method": "auto", "auto": {"warm_iterations": 50}}"#,
+            "auto.warm_iterations",
+            "out of range",
+        ),
+        (
+            r#"{"method": "auto", "auto": {"initial": [[0,0],[1,0]]}}"#,
+            "auto.initial",
+            "(2^i + 1)",
+        ),
+        (
+            r#"{"method": "auto", "auto": {"initial": [[0,0],[50,0],[100,0],[0,50],[150,45],[100,50],[0,100],[50,100],[100,100]]}}"#,
+            "auto.initial",
+            "not convex",
+        ),
+        (
+            r#"{"method": "auto", "auto": {"speed": 3}}"#,
+            "line",
+            "unknown field",
+        ),
+    ];
+    for (text, at, message) in cases {
+        let (got_at, got_message) = err(text);
+        assert!(
+            got_at.starts_with(at),
+            "{text}: at = {got_at:?}, wanted {at:?}"
+        );
+        assert!(
+            got_message.contains(message),
+            "{text}: message = {got_message:?}"
+        );
+    }
 }
 
 /// A 3 × 3 mesh over 0..20 whose centre node moves from (10, 10) to `centre`.
