@@ -830,7 +830,14 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
     mesh_scene["mesh"] = serde_json::json!({ "rows": 5, "cols": 5, "a": nodes_a, "b": nodes_b });
     let mut triangles_scene = scene.clone();
     triangles_scene["method"] = "triangles".into();
-    for (name, scene) in [("mesh", mesh_scene), ("triangles", triangles_scene)] {
+    // And found from the plates alone, the features as anchors.
+    let mut auto_scene = scene.clone();
+    auto_scene["method"] = "auto".into();
+    for (name, scene) in [
+        ("mesh", mesh_scene),
+        ("triangles", triangles_scene),
+        ("auto", auto_scene),
+    ] {
         render(
             name,
             &scene,
@@ -857,9 +864,10 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
         dir.join("stmap_a.####.exr").display()
     );
     println!(
-        "  methods:  {} and {} (the same morph by mesh and by triangles, PNG)",
+        "  methods:  {}, {} and {} (the same morph by mesh, by triangles and by auto, PNG)",
         dir.join("mesh/morph.####.png").display(),
-        dir.join("triangles/morph.####.png").display()
+        dir.join("triangles/morph.####.png").display(),
+        dir.join("auto/morph.####.png").display()
     );
     Ok(())
 }

@@ -247,7 +247,7 @@ fn a_panic_inside_the_plugin_becomes_a_failure_status_not_a_crash() {
     assert!(!out.exists());
 }
 
-/// The demo renders the same morph by field, mesh and triangles; whatever
+/// The demo renders the same morph by field, mesh, triangles and auto; whatever
 /// the method, the first frame (t = 0) is plate A and the last (t = 1) plate
 /// B, pixel for pixel.
 #[test]
@@ -261,7 +261,7 @@ fn demo_renders_every_built_method_with_exact_end_frames() {
             .image
     };
     let (a, b) = (read(d.join("plates/a.exr")), read(d.join("plates/b.exr")));
-    for method in ["preview", "mesh", "triangles"] {
+    for method in ["preview", "mesh", "triangles", "auto"] {
         let first = read(d.join(format!("{method}/morph.0001.png")));
         let last = read(d.join(format!("{method}/morph.0012.png")));
         for (got, want, which) in [(&first, &a, "A"), (&last, &b, "B")] {
