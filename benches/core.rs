@@ -14,6 +14,7 @@ use morphfx::image::resample::{resample, ResampleSettings};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
+use morphfx::testing::texture;
 use morphfx::warp::auto::{self, AutoSettings, WorkImage};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
 use morphfx::warp::mesh::{self, Mesh, MeshWarp};
@@ -273,14 +274,8 @@ fn bench_snakes(c: &mut Criterion) {
 /// A textured plate pair of `w x h` where B is A under a smooth warp of up
 /// to 2% of the frame (the kind of pair `auto` is for).
 fn auto_pair(w: usize, h: usize) -> (WorkImage, WorkImage) {
-    let tex = |x: f64, y: f64| {
-        let (x, y) = (x * 256.0 / w as f64, y * 256.0 / w as f64);
-        [
-            (0.5 + 0.25 * (x / 7.0).sin() * (y / 9.0).cos() + 0.2 * ((x + y) / 13.0).sin()) as f32,
-            (0.5 + 0.3 * ((x - 0.5 * y) / 11.0).cos() + 0.15 * (y / 5.0).sin()) as f32,
-            (0.4 + 0.3 * ((x * x + y * y).sqrt() / 8.0).sin()) as f32,
-        ]
-    };
+    // The texture at the scale of a 256-wide plate, whatever the size.
+    let tex = |x: f64, y: f64| texture(Vec2::new(x, y) * (256.0 / w as f64));
     let warp = |x: f64, y: f64| {
         let (u, v) = (x / w as f64, y / h as f64);
         let bump = (std::f64::consts::PI * u).sin() * (std::f64::consts::PI * v).sin();

@@ -16,6 +16,7 @@ pub mod image;
 pub mod morph;
 pub mod scene;
 pub mod snake;
+pub mod testing;
 pub mod views;
 pub mod warp;
 

@@ -9,21 +9,13 @@ mod common;
 use morphfx::features::Side;
 use morphfx::geom::{RectD, RectI, Vec2};
 use morphfx::image::Image;
+use morphfx::testing::texture;
 use morphfx::warp::auto::{self, AutoSettings, WorkImage};
 use morphfx::warp::Warp;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 
 const W: usize = 160;
 const H: usize = 120;
-
-fn texture(p: Vec2) -> [f32; 3] {
-    let (x, y) = (p.x, p.y);
-    [
-        (0.5 + 0.25 * (x / 7.0).sin() * (y / 9.0).cos() + 0.2 * ((x + y) / 13.0).sin()) as f32,
-        (0.5 + 0.3 * ((x - 0.5 * y) / 11.0).cos() + 0.15 * (y / 5.0).sin()) as f32,
-        (0.4 + 0.3 * ((x * x + y * y).sqrt() / 8.0).sin()) as f32,
-    ]
-}
 
 /// The known reverse warp: B(y) = A(H(y)); up to 5 px, still at the border.
 fn h(p: Vec2) -> Vec2 {

@@ -197,39 +197,40 @@ impl Scene {
     }
 }
 
+/// `v` (`default` when absent) if it lies in `range` (NaN never does), else
+/// the error that names `at` and the range.
+fn in_range<T: PartialOrd + Copy + std::fmt::Display>(
+    v: Option<T>,
+    default: T,
+    range: std::ops::RangeInclusive<T>,
+    at: &str,
+) -> Result<T> {
+    match v {
+        None => Ok(default),
+        Some(x) if range.contains(&x) => Ok(x),
+        Some(x) => Err(Error::scene(
+            at,
+            format!("{x} is out of range: {} to {}", range.start(), range.end()),
+        )),
+    }
+}
+
 /// The `auto` key: each number in its range, the initial warp a legal grid.
 fn auto_settings(raw: RawAuto) -> Result<AutoSettings> {
     let d = AutoSettings::default();
-    let weight = |v: Option<f64>, default: f64, key: &str| -> Result<f64> {
-        match v {
-            None => Ok(default),
-            Some(x) if x.is_finite() && (0.0..=1000.0).contains(&x) => Ok(x),
-            Some(x) => Err(Error::scene(
-                format!("auto.{key}"),
-                format!("{x} is out of range: 0 to 1000"),
-            )),
-        }
+    let weight = |v: Option<f64>, default: f64, key: &str| {
+        in_range(v, default, 0.0..=1000.0, &format!("auto.{key}"))
     };
-    let levels = match raw.levels {
-        None => None,
-        Some(l) if (1..=MAX_LEVEL).contains(&l) => Some(l),
-        Some(l) => {
-            return Err(Error::scene(
-                "auto.levels",
-                format!("{l} is out of range: 1 to {MAX_LEVEL}"),
-            ))
-        }
-    };
-    let warm_iterations = match raw.warm_iterations {
-        None => d.warm_iterations,
-        Some(n) if (1..=10).contains(&n) => n,
-        Some(n) => {
-            return Err(Error::scene(
-                "auto.warm_iterations",
-                format!("{n} is out of range: 1 to 10"),
-            ))
-        }
-    };
+    let levels = raw
+        .levels
+        .map(|l| in_range(Some(l), l, 1..=MAX_LEVEL, "auto.levels"))
+        .transpose()?;
+    let warm_iterations = in_range(
+        raw.warm_iterations,
+        d.warm_iterations,
+        1..=10,
+        "auto.warm_iterations",
+    )?;
     let initial = match raw.initial {
         None => None,
         Some(pts) => {
@@ -295,16 +296,12 @@ fn field_settings(raw: RawField) -> Result<FieldSettings> {
             ))
         }
     };
-    let curve_samples = match raw.curve_samples {
-        None => d.curve_samples,
-        Some(n) if (1..=100).contains(&n) => n,
-        Some(n) => {
-            return Err(Error::scene(
-                "field.curve_samples",
-                format!("{n} is out of range: 1 to 100"),
-            ))
-        }
-    };
+    let curve_samples = in_range(
+        raw.curve_samples,
+        d.curve_samples,
+        1..=100,
+        "field.curve_samples",
+    )?;
     Ok(FieldSettings {
         a: num(
             raw.a,

@@ -1,19 +1,10 @@
 use super::grid::{inverse_bilinear, is_convex_ccw, lattice, Grid};
 use super::*;
 use crate::geom::Vec2;
+use crate::testing::texture;
 use crate::warp::Warp;
 
 const SIZE: usize = 128;
-
-/// A smooth, everywhere-textured colour field (canonical pixels).
-fn texture(p: Vec2) -> [f32; 3] {
-    let (x, y) = (p.x, p.y);
-    [
-        (0.5 + 0.25 * (x / 7.0).sin() * (y / 9.0).cos() + 0.2 * ((x + y) / 13.0).sin()) as f32,
-        (0.5 + 0.3 * ((x - 0.5 * y) / 11.0).cos() + 0.15 * (y / 5.0).sin()) as f32,
-        (0.4 + 0.3 * ((x * x + y * y).sqrt() / 8.0).sin()) as f32,
-    ]
-}
 
 /// The known warp: B(y) = A(H(y)), a smooth displacement of up to 5 px that
 /// vanishes at the frame's border.
