@@ -62,6 +62,17 @@ pub fn default_levels(width: usize, height: usize) -> u32 {
 /// Pixels a quad spans, at least, in the plate its work is priced on.
 const QUAD_SAMPLES: f64 = 32.0;
 
+/// The plate level `level`'s search prices on: the full plate, or the
+/// halving at which a quad still spans `QUAD_SAMPLES` pixels.
+fn pick<'i>(full: &'i WorkImage, halvings: &'i [WorkImage], level: u32) -> &'i WorkImage {
+    let quad = full.width.min(full.height) as f64 / (1u64 << level) as f64;
+    let k = (quad / QUAD_SAMPLES).log2().floor().max(0.0) as usize;
+    match k.min(halvings.len()) {
+        0 => full,
+        k => &halvings[k - 1],
+    }
+}
+
 /// Where the search starts.
 #[derive(Debug, Clone)]
 pub enum Start<'a> {
@@ -124,12 +135,7 @@ pub fn solve(
     // quad spans about `QUAD_SAMPLES` pixels or more (a coarse-to-fine
     // pyramid: big quads need no per-pixel detail, and blur smooths the
     // work's landscape). The table reports full-resolution work.
-    let (pa, pb) = (a.clone().pyramid(8), b.clone().pyramid(8));
-    let pick = |pyr: &'_ [WorkImage], level: u32| -> usize {
-        let quad = pyr[0].width.min(pyr[0].height) as f64 / (1u64 << level) as f64;
-        let k = (quad / QUAD_SAMPLES).log2().floor().max(0.0) as usize;
-        k.min(pyr.len() - 1)
-    };
+    let (ha, hb) = (a.halvings(8), b.halvings(8));
     let mut table = vec![LevelWork {
         level: 0,
         work: Pricer::new(a, b, first, anchors, c)
@@ -148,13 +154,7 @@ pub fn solve(
                 "auto: the initial warp cannot be pulled onto the frame without folding".into(),
             ));
         }
-        let search = Pricer::new(
-            &pa[pick(&pa, level)],
-            &pb[pick(&pb, level)],
-            level,
-            anchors,
-            c,
-        );
+        let search = Pricer::new(pick(a, &ha, level), pick(b, &hb, level), level, anchors, c);
         let mut works = search.all(&grid);
         let iterations = if warm {
             settings.warm_iterations

@@ -83,23 +83,18 @@ impl WorkImage {
         }
     }
 
-    /// This image and its halvings while the smaller side keeps at least
-    /// `min_side` pixels.
-    pub fn pyramid(self, min_side: usize) -> Vec<WorkImage> {
-        let mut levels = vec![self];
+    /// Successive halvings of this image while the smaller side keeps at
+    /// least `min_side` pixels (the image itself not included).
+    pub fn halvings(&self, min_side: usize) -> Vec<WorkImage> {
+        let mut levels: Vec<WorkImage> = Vec::new();
         loop {
-            let last = levels.last().expect("one level");
+            let last = levels.last().unwrap_or(self);
             if last.width.min(last.height) / 2 < min_side {
                 return levels;
             }
             let next = last.half();
             levels.push(next);
         }
-    }
-
-    #[inline]
-    pub fn pixel(&self, i: usize, j: usize) -> [f32; 4] {
-        self.pixels[j * self.width + i]
     }
 
     fn row(&self, j: usize) -> &[[f32; 4]] {
@@ -212,7 +207,6 @@ pub struct Pricer<'a> {
     a: &'a WorkImage,
     b: &'a WorkImage,
     n: usize,
-    level: u32,
     colour: f64,
     stretch: f64,
     angle: f64,
@@ -267,7 +261,6 @@ impl<'a> Pricer<'a> {
             a,
             b,
             n,
-            level,
             colour: c.colour * 256.0 * 256.0 / (a.width * a.height) as f64,
             stretch: c.stretch * 400.0,
             angle: c.angle * 600.0 / (256.0 * 256.0) / n as f64,
@@ -277,15 +270,6 @@ impl<'a> Pricer<'a> {
             rows: bounds(a.height),
             pinned,
         }
-    }
-
-    pub fn level(&self) -> u32 {
-        self.level
-    }
-
-    /// The anchor tolerance at this level, in the unit square.
-    pub fn anchor_tolerance(&self) -> f64 {
-        self.delta / 256.0 / 2.0
     }
 
     /// The work of quad `(j, k)` when its corners are `q`.
@@ -369,19 +353,6 @@ impl<'a> Pricer<'a> {
             .map(|i| {
                 let (j, k) = (i % n, i / n);
                 self.quad(j, k, &grid.quad(j, k))
-            })
-            .collect()
-    }
-
-    /// How far anchors are from their targets under `grid`, in the unit square.
-    pub fn anchor_errors(&self, grid: &super::grid::Grid) -> Vec<f64> {
-        let n = self.n;
-        (0..n * n)
-            .flat_map(|i| {
-                let q = grid.quad(i % n, i / n);
-                self.pinned[i]
-                    .iter()
-                    .map(move |p| (bilinear(&q, p.s, p.t) - p.b).length())
             })
             .collect()
     }
