@@ -9,6 +9,7 @@
 //! at `(i + 0.5, j + 0.5)` (CONTRACT §1).
 #![forbid(unsafe_code)]
 
+pub mod bspline;
 pub mod error;
 pub mod features;
 pub mod geom;
@@ -17,6 +18,7 @@ pub mod morph;
 pub mod scene;
 pub mod snake;
 pub mod testing;
+pub mod transition;
 pub mod views;
 pub mod warp;
 

@@ -3,6 +3,7 @@
 
 use crate::image::resample::{adapt_channels, fill_rows, row_through};
 use crate::image::{Plane, RowsMut, Sample, Sampler};
+use crate::transition::Weights;
 use crate::warp::WarpMap;
 
 /// A warped source as the dissolve reads it: resampled through a reverse
@@ -79,6 +80,48 @@ pub fn dissolve<S: Sample, D: Sample>(
                 for c in 0..4 {
                     pa[c] = wa * pa[c] + wb * pb[c];
                 }
+            }
+        }
+    });
+}
+
+/// The dissolve with a weight per pixel and side (seed 000 §3: `I = W0 •
+/// ((1 − T0) I0) + W1 • (T1 I1)`): `dst = w_a · A + w_b · B`, weights from
+/// [`crate::transition::colour_weights`] over a window that covers `dst`
+/// (pixels outside it take the plain `1 − t`, `t`).
+pub fn dissolve_weighted<S: Sample, D: Sample>(
+    a: Warped<'_, S>,
+    b: Warped<'_, S>,
+    t: f64,
+    weights: &Weights,
+    dst: RowsMut<'_, D>,
+) {
+    let dc = dst.channels;
+    let win = weights.window;
+    let (ua, ub) = ((1.0 - t) as f32, t as f32);
+    fill_rows(dst, dc, |j, x1, row, other| {
+        let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| {
+            src.row(j, x1, out);
+            let channels = src.channels();
+            if channels != dc {
+                for px in out.iter_mut() {
+                    *px = adapt_channels(channels, dc, *px);
+                }
+            }
+        };
+        other.resize(row.len(), [0.0; 4]);
+        warped(&a, row);
+        warped(&b, other);
+        for (k, (pa, pb)) in row.iter_mut().zip(other.iter()).enumerate() {
+            let i = x1 + k as i32;
+            let (wa, wb) = if i >= win.x1 && i < win.x2 && j >= win.y1 && j < win.y2 {
+                let n = (j - win.y1) as usize * win.width() + (i - win.x1) as usize;
+                (weights.a[n], weights.b[n])
+            } else {
+                (ua, ub)
+            };
+            for c in 0..4 {
+                pa[c] = wa * pa[c] + wb * pb[c];
             }
         }
     });

@@ -14,3 +14,64 @@ pub fn texture(p: Vec2) -> [f32; 3] {
         (0.4 + 0.3 * ((x * x + y * y).sqrt() / 8.0).sin()) as f32,
     ]
 }
+
+/// A small deterministic generator (PCG-style LCG) for generated tests and
+/// benchmarks: the same seed gives the same case on every machine.
+pub struct Lcg(u64);
+
+impl Lcg {
+    pub fn new(seed: u64) -> Self {
+        Lcg(seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407))
+    }
+
+    /// Uniform in `[0, 1)`.
+    pub fn unit(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+}
+
+/// `n` points at least `gap` apart inside `[margin, w − margin] × [margin,
+/// h − margin]`, each paired with its place under a smooth displacement of
+/// amplitude up to `shift` px whose gradient stays below 1/2: a
+/// non-crossing constraint set (no two paths can cross, the map it samples
+/// is one-to-one).
+pub fn smooth_pairs(
+    seed: u64,
+    n: usize,
+    w: f64,
+    h: f64,
+    shift: f64,
+    gap: f64,
+) -> Vec<(Vec2, Vec2)> {
+    let mut r = Lcg::new(seed);
+    let margin = 2.0 * shift + 4.0;
+    let length = 4.0 * shift.max(1.0);
+    let phase: [f64; 4] = std::array::from_fn(|_| r.range(0.0, std::f64::consts::TAU));
+    let field = |p: Vec2| {
+        Vec2::new(
+            shift * (p.x / length + phase[0]).sin() * (p.y / length + phase[1]).cos(),
+            shift * (p.x / length + phase[2]).cos() * (p.y / length + phase[3]).sin(),
+        )
+    };
+    let mut points: Vec<Vec2> = Vec::with_capacity(n);
+    let mut tries = 0;
+    while points.len() < n && tries < 100 * n {
+        tries += 1;
+        let p = Vec2::new(r.range(margin, w - margin), r.range(margin, h - margin));
+        if points.iter().all(|q| q.distance(p) >= gap) {
+            points.push(p);
+        }
+    }
+    points.into_iter().map(|p| (p, p + field(p))).collect()
+}

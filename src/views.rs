@@ -5,6 +5,7 @@
 use crate::features::{sample_points, Feature, FeatureKind};
 use crate::geom::Vec2;
 use crate::image::{resample::fill, RowsMut, Sample};
+use crate::transition::Rates;
 use crate::warp::WarpMap;
 
 /// The output view a node renders (CONTRACT §3 `--view`).
@@ -63,10 +64,22 @@ pub fn stmap<D: Sample>(map: &WarpMap, origin: Vec2, size: Vec2, dst: RowsMut<'_
     });
 }
 
-/// A constant grey of the geometry transition rate (uniform dissolve: `t`).
-pub fn transition_grey<D: Sample>(rate: f64, dst: RowsMut<'_, D>) {
-    let r = rate as f32;
-    fill(dst, 4, |_, _, px| *px = [r, r, r, 1.0]);
+/// The geometry transition rate as grey: at each output pixel, the rate of
+/// the point of A it shows (`map_a`); pixels outside the map take `t`.
+pub fn transition_grey<D: Sample>(rates: &Rates, map_a: &WarpMap, dst: RowsMut<'_, D>) {
+    let win = map_a.window;
+    let uniform = rates.uniform();
+    let t = rates.t() as f32;
+    fill(dst, 4, |i, j, px| {
+        let r = match uniform {
+            Some(u) => u as f32,
+            None if i >= win.x1 && i < win.x2 && j >= win.y1 && j < win.y2 => {
+                rates.at(map_a.get(i, j)) as f32
+            }
+            None => t,
+        };
+        *px = [r, r, r, 1.0];
+    });
 }
 
 /// Grid spacing of the grid view, canonical pixels.

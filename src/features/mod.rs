@@ -114,3 +114,65 @@ impl Feature {
         }
     }
 }
+
+/// Where each feature point is along its way from A to B at one instant:
+/// one progress `t` for every point, or a rate per point taken from its
+/// position on A (transition control, seed 000 §3: `T0(p; t)`).
+#[derive(Clone, Copy)]
+pub struct Tween<'a> {
+    pub t: f64,
+    rate: Option<&'a (dyn Fn(Vec2) -> f64 + Sync)>,
+}
+
+impl<'a> Tween<'a> {
+    pub fn uniform(t: f64) -> Self {
+        Tween { t, rate: None }
+    }
+
+    /// Rates from `rate(p_A)`, each in `[0, 1]`.
+    pub fn with_rates(t: f64, rate: &'a (dyn Fn(Vec2) -> f64 + Sync)) -> Self {
+        Tween {
+            t,
+            rate: Some(rate),
+        }
+    }
+
+    pub fn is_uniform(&self) -> bool {
+        self.rate.is_none()
+    }
+
+    /// The rate of the point at `a` on image A.
+    #[inline]
+    pub fn rate(&self, a: Vec2) -> f64 {
+        self.rate.map_or(self.t, |f| f(a))
+    }
+
+    /// The in-between position of a point at `a` on A and `b` on B; the end
+    /// rates return `a` and `b` bit for bit.
+    #[inline]
+    pub fn between(&self, a: Vec2, b: Vec2) -> Vec2 {
+        let r = self.rate(a);
+        if r == 0.0 {
+            a
+        } else if r == 1.0 {
+            b
+        } else {
+            a.lerp(b, r)
+        }
+    }
+}
+
+impl From<f64> for Tween<'static> {
+    fn from(t: f64) -> Self {
+        Tween::uniform(t)
+    }
+}
+
+impl std::fmt::Debug for Tween<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.rate {
+            None => write!(f, "Tween({})", self.t),
+            Some(_) => write!(f, "Tween({}, per point)", self.t),
+        }
+    }
+}

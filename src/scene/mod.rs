@@ -2,13 +2,18 @@
 //! queried for the features and the progress at any frame.
 
 mod parse;
+mod scattered;
 #[cfg(test)]
 mod tests;
 
 use crate::features::{Feature, DEFAULT_SAMPLES_PER_SEGMENT};
+use crate::transition::TransitionSettings;
 use crate::warp::auto::AutoSettings;
 use crate::warp::field::FieldSettings;
+use crate::warp::hybrid::HybridSettings;
 use crate::warp::mesh::{MeshPair, MeshSettings};
+use crate::warp::mffd::MffdSettings;
+use crate::warp::thin_plate::ThinPlateSettings;
 
 pub use parse::FORMAT;
 
@@ -52,25 +57,6 @@ impl Method {
         Self::ALL.into_iter().find(|m| m.name() == s)
     }
 
-    /// Whether this build can render the method. The others are accepted in
-    /// scenes (so files stay valid) but refuse to render with a clear message.
-    pub fn is_available(self) -> bool {
-        matches!(
-            self,
-            Method::Field | Method::Mesh | Method::Triangles | Method::Auto
-        )
-    }
-
-    /// The methods this build renders, for messages: `field, mesh, ...`.
-    pub fn available_names() -> String {
-        let names: Vec<_> = Self::ALL
-            .iter()
-            .filter(|m| m.is_available())
-            .map(|m| m.name())
-            .collect();
-        names.join(", ")
-    }
-
     /// Methods that cannot do anything without features (`auto` finds its own
     /// correspondence, `mesh` takes its own mesh).
     pub fn needs_features(self) -> bool {
@@ -96,6 +82,12 @@ pub struct Scene {
     pub meshes: Vec<(f64, MeshPair)>,
     /// Settings of `auto` (scene key `auto`).
     pub auto: AutoSettings,
+    /// Settings of `thin-plate`, `mffd` and `hybrid` (scene keys of those names).
+    pub thin_plate: ThinPlateSettings,
+    pub mffd: MffdSettings,
+    pub hybrid: HybridSettings,
+    /// Transition control (scene key `transition`).
+    pub transition: TransitionSettings,
     /// Samples per polyline/curve span for point-based methods (seed 000 §4.2).
     pub samples_per_segment: usize,
     /// The features when there are no keyframes.
@@ -117,6 +109,10 @@ impl Default for Scene {
             mesh: MeshSettings::default(),
             meshes: Vec::new(),
             auto: AutoSettings::default(),
+            thin_plate: ThinPlateSettings::default(),
+            mffd: MffdSettings::default(),
+            hybrid: HybridSettings::default(),
+            transition: TransitionSettings::default(),
             samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
             features: Vec::new(),
             keyframes: Vec::new(),

@@ -172,17 +172,26 @@ impl Scene {
             Some(keys) => progress(keys)?,
             None => Vec::new(),
         };
+        let mut extra = raw.extra;
+        let scattered = super::scattered::read(
+            &mut extra,
+            keyframes.first().map_or(&features, |k| &k.features),
+        )?;
         let scene = Scene {
             method,
             field,
             mesh,
             meshes,
             auto,
+            thin_plate: scattered.thin_plate,
+            mffd: scattered.mffd,
+            hybrid: scattered.hybrid,
+            transition: scattered.transition,
             samples_per_segment,
             features,
             keyframes,
             progress,
-            extra: raw.extra,
+            extra,
         };
         if method.needs_features() && !scene.has_features() {
             return Err(Error::scene(
@@ -199,7 +208,7 @@ impl Scene {
 
 /// `v` (`default` when absent) if it lies in `range` (NaN never does), else
 /// the error that names `at` and the range.
-fn in_range<T: PartialOrd + Copy + std::fmt::Display>(
+pub(super) fn in_range<T: PartialOrd + Copy + std::fmt::Display>(
     v: Option<T>,
     default: T,
     range: std::ops::RangeInclusive<T>,

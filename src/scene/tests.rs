@@ -134,10 +134,179 @@ fn refuses_each_kind_of_bad_scene_naming_the_culprit() {
 }
 
 #[test]
-fn settings_of_methods_to_come_are_kept() {
-    let text = r#"{"method": "field", "features": [{"type": "point", "a": [[1, 2]], "b": [[3, 4]]}], "thin-plate": {"alpha": 4}}"#;
+fn keys_of_other_tools_are_kept() {
+    let text = r#"{"method": "field", "features": [{"type": "point", "a": [[1, 2]], "b": [[3, 4]]}], "x-studio": {"shot": 12}}"#;
     let s = Scene::parse(text).unwrap();
-    assert!(s.extra.contains_key("thin-plate"));
+    assert!(s.extra.contains_key("x-studio"));
+}
+
+const TWO_FEATURES: &str = r#""features": [
+    {"name": "nose", "type": "line", "a": [[10, 10], [20, 20]], "b": [[12, 10], [22, 20]]},
+    {"type": "point", "a": [[40, 40]], "b": [[44, 41]]}]"#;
+
+#[test]
+fn scattered_method_and_transition_settings_are_read() {
+    use crate::transition::{Attach, Pattern, Propagation, Transition};
+    let text = format!(
+        r#"{{"method": "hybrid", {TWO_FEATURES},
+        "thin-plate": {{"alpha": 40, "beta": 0.001, "cell": 8}},
+        "mffd": {{"coarsest": 3, "alpha": 0.25, "tolerance": 0.02}},
+        "hybrid": {{"cell": 32}},
+        "transition": {{
+            "geometry": {{"type": "curves", "curves": [
+                {{"feature": "nose", "keys": [[0.5, 0.9]]}},
+                {{"feature": 1, "keys": [[0.2, 0.0], [0.8, 0.1]]}},
+                {{"at": [100, 50], "keys": []}}], "threshold": 0.01}},
+            "colour": {{"type": "procedural", "pattern": "radial", "spread": 0.4, "centre": [5, 6]}}}}}}"#
+    );
+    let s = Scene::parse(&text).unwrap();
+    assert_eq!(s.method, Method::Hybrid);
+    assert_eq!(
+        (s.thin_plate.alpha, s.thin_plate.beta, s.thin_plate.cell),
+        (40.0, 0.001, 8.0)
+    );
+    assert_eq!(
+        (s.mffd.coarsest, s.mffd.alpha, s.mffd.tolerance),
+        (3, 0.25, 0.02)
+    );
+    assert_eq!(s.hybrid.cell, 32.0);
+    assert_eq!(
+        s.hybrid.thin_plate, s.thin_plate,
+        "hybrid's plate is the thin-plate key's"
+    );
+    let Transition::Curves {
+        curves,
+        propagation,
+    } = &s.transition.geometry
+    else {
+        panic!("{:?}", s.transition.geometry)
+    };
+    assert_eq!(curves[0].attach, Attach::Name("nose".into()));
+    assert_eq!(curves[1].attach, Attach::Index(1));
+    assert_eq!(curves[2].attach, Attach::At(crate::Vec2::new(100.0, 50.0)));
+    assert!((curves[0].curve.at(0.5) - 0.9).abs() < 1e-12);
+    assert!((curves[0].curve.at(0.75) - 0.95).abs() < 1e-12);
+    assert_eq!(curves[2].curve.at(0.3), 0.3, "no keys: the uniform rate");
+    assert!(matches!(propagation, Propagation::BSpline(m) if m.threshold == 0.01));
+    let Some(Transition::Procedural(p)) = &s.transition.colour else {
+        panic!("{:?}", s.transition.colour)
+    };
+    assert_eq!(p.spread, 0.4);
+    assert_eq!(
+        p.pattern,
+        Pattern::Radial {
+            cycles: 0.0,
+            centre: Some(crate::Vec2::new(5.0, 6.0))
+        }
+    );
+    assert!(!s.extra.contains_key("transition"));
+}
+
+#[test]
+fn bad_scattered_and_transition_settings_are_refused() {
+    let scene = |extra: &str| format!(r#"{{"method": "mffd", {TWO_FEATURES}, {extra}}}"#);
+    let cases = [
+        (
+            r#""thin-plate": {"alpha": 0}"#,
+            "thin-plate.alpha",
+            "greater than 0",
+        ),
+        (
+            r#""thin-plate": {"beta": -1}"#,
+            "thin-plate.beta",
+            "out of range",
+        ),
+        (
+            r#""thin-plate": {"stiffness": 1}"#,
+            "thin-plate",
+            "unknown field",
+        ),
+        (r#""mffd": {"alpha": 2}"#, "mffd.alpha", "out of range"),
+        (r#""mffd": {"finest": 0}"#, "mffd.finest", "out of range"),
+        (r#""hybrid": {"cell": 1}"#, "hybrid.cell", "out of range"),
+        (
+            r#""transition": {"geometry": {"type": "wipe"}}"#,
+            "transition.geometry.type",
+            "unknown transition type",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves"}}"#,
+            "transition.geometry.curves",
+            "needs a list",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [{"feature": "ear", "keys": []}]}}"#,
+            "transition.geometry.curves[0].feature",
+            "no feature is named \"ear\"",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [{"feature": 2, "keys": []}]}}"#,
+            "transition.geometry.curves[0].feature",
+            "not the index",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [{"keys": []}]}}"#,
+            "transition.geometry.curves[0]",
+            "attach the curve",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [{"at": [1, 2], "keys": [[0.5, 1.2]]}]}}"#,
+            "transition.geometry.curves[0].keys[0]",
+            "in [0, 1]",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [{"at": [1, 2], "keys": [[0.6, 0.5], [0.4, 0.6]]}]}}"#,
+            "transition.geometry.curves[0].keys[1]",
+            "does not come after",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [{"at": [1, 2], "keys": [[0, 0.3]]}]}}"#,
+            "transition.geometry.curves[0].keys[0]",
+            "rate 0 at t = 0",
+        ),
+        (
+            r#""transition": {"geometry": {"type": "curves", "curves": [], "surface": "soap"}}"#,
+            "transition.geometry.surface",
+            "unknown surface",
+        ),
+        (
+            r#""transition": {"colour": {"type": "procedural", "pattern": "spiral"}}"#,
+            "transition.colour.pattern",
+            "unknown pattern",
+        ),
+        (
+            r#""transition": {"colour": {"type": "procedural", "spread": 1}}"#,
+            "transition.colour.spread",
+            "out of range",
+        ),
+        (
+            r#""transition": {"colour": {"type": "procedural", "centre": [1, 2]}}"#,
+            "transition.colour.centre",
+            "only the radial",
+        ),
+        (
+            r#""transition": {"colour": {"type": "uniform", "spread": 0.5}}"#,
+            "transition.colour.spread",
+            "does not apply",
+        ),
+        (
+            r#""transition": {"colour": {"type": "procedural", "curves": []}}"#,
+            "transition.colour.curves",
+            "does not apply",
+        ),
+    ];
+    for (extra, at, message) in cases {
+        let text = scene(extra);
+        let (got_at, got_message) = err(&text);
+        assert!(
+            got_at.starts_with(at),
+            "{extra}: at = {got_at:?}, wanted {at:?}"
+        );
+        assert!(
+            got_message.contains(message),
+            "{extra}: message = {got_message:?}, wanted {message:?}"
+        );
+    }
 }
 
 #[test]

@@ -4,9 +4,16 @@
 
 pub mod auto;
 pub mod field;
+pub mod hybrid;
 mod map;
 pub mod mesh;
+pub mod mffd;
+pub mod node_grid;
+pub mod thin_plate;
 pub mod triangles;
+
+#[cfg(test)]
+mod scattered_tests;
 
 pub use map::WarpMap;
 
@@ -79,12 +86,16 @@ impl Warp for Identity {
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
-use crate::features::{Feature, Side, DEFAULT_SAMPLES_PER_SEGMENT};
+use crate::features::{Feature, Side, Tween, DEFAULT_SAMPLES_PER_SEGMENT};
 use crate::geom::RectD;
 use crate::scene::{Method, Scene};
+use crate::transition::{Rates, TransitionSettings};
 use auto::{AutoSettings, Correspondence};
 use field::{FieldSettings, FieldWarp};
+use hybrid::HybridSettings;
 use mesh::{MeshPair, MeshSettings, MeshWarp};
+use mffd::{Mffd, MffdSettings, MffdWarp};
+use thin_plate::{ThinPlate, ThinPlateSettings, ThinPlateWarp};
 use triangles::TriangleWarp;
 
 /// Everything a warp generator depends on besides the features: the method,
@@ -102,6 +113,12 @@ pub struct WarpSettings {
     /// features' bounds grown by half their size on each side.
     pub frame: Option<RectD>,
     pub auto: AutoSettings,
+    pub thin_plate: ThinPlateSettings,
+    pub mffd: MffdSettings,
+    pub hybrid: HybridSettings,
+    /// Transition control: the geometry rates move each feature point at its
+    /// own pace; the colour rates are the dissolve's (see [`crate::transition`]).
+    pub transition: TransitionSettings,
     /// The correspondence `auto` solved for this frame from both images
     /// ([`auto::correspond`]); the warps only read it.
     pub correspondence: Option<Arc<Correspondence>>,
@@ -117,6 +134,10 @@ impl Default for WarpSettings {
             meshes: None,
             frame: None,
             auto: AutoSettings::default(),
+            thin_plate: ThinPlateSettings::default(),
+            mffd: MffdSettings::default(),
+            hybrid: HybridSettings::default(),
+            transition: TransitionSettings::default(),
             correspondence: None,
         }
     }
@@ -133,6 +154,10 @@ impl WarpSettings {
             meshes: s.mesh_at(frame),
             frame: None,
             auto: s.auto.clone(),
+            thin_plate: s.thin_plate,
+            mffd: s.mffd,
+            hybrid: s.hybrid,
+            transition: s.transition.clone(),
             correspondence: None,
         }
     }
@@ -151,51 +176,125 @@ impl WarpSettings {
 }
 
 /// The warp of the image on `side` toward the features' positions at `t`
-/// (`t = 0`: A's positions, `t = 1`: B's), as a reverse map. For `mesh` this
-/// is the one-pass map; the two-pass warp makes pixels ([`mesh::two_pass`]).
+/// (`t = 0`: A's positions, `t = 1`: B's), as a reverse map. With a geometry
+/// transition each feature point travels at its own rate. For `mesh` this is
+/// the one-pass map; the two-pass warp makes pixels ([`mesh::two_pass`]).
 pub fn toward(
     features: &[Feature],
     side: Side,
     t: f64,
     settings: &WarpSettings,
 ) -> Result<Arc<dyn Warp>> {
+    let rates = settings.geometry_rates(features, t)?;
+    let rate = |p: Vec2| rates.at(p);
+    let tween = match rates.uniform() {
+        Some(t) => Tween::uniform(t),
+        None => Tween::with_rates(t, &rate),
+    };
+    let frame = || {
+        settings
+            .frame
+            .or_else(|| feature_bounds(features))
+            .ok_or_else(|| {
+                Error::Invalid(format!(
+                    "method \"{}\" needs at least one feature point",
+                    settings.method.name()
+                ))
+            })
+    };
+    let pairs = || point_pairs_toward(features, side, tween, settings.samples_per_segment);
     match settings.method {
         Method::Field => Ok(Arc::new(FieldWarp::toward(
             features,
             side,
-            t,
+            tween,
             &settings.field,
         ))),
-        Method::Mesh => Ok(Arc::new(MeshWarp::toward(settings.mesh_pair()?, side, t))),
-        Method::Triangles => {
-            let frame = match settings.frame {
-                Some(f) => f,
-                None => feature_bounds(features).ok_or_else(|| {
-                    Error::Invalid("method \"triangles\" needs at least one feature point".into())
-                })?,
-            };
-            Ok(Arc::new(TriangleWarp::toward(
-                features,
-                side,
-                t,
-                settings.samples_per_segment,
-                frame,
-            )?))
-        }
+        Method::Mesh => Ok(Arc::new(MeshWarp::toward(
+            settings.mesh_pair()?,
+            side,
+            tween,
+        ))),
+        Method::Triangles => Ok(Arc::new(TriangleWarp::toward(
+            features,
+            side,
+            tween,
+            settings.samples_per_segment,
+            frame()?,
+        )?)),
+        Method::ThinPlate => Ok(Arc::new(ThinPlateWarp::new(ThinPlate::solve(
+            &pairs(),
+            frame()?,
+            &settings.thin_plate,
+            None,
+        )))),
+        Method::Mffd => Ok(Arc::new(MffdWarp {
+            mffd: Mffd::solve(&pairs(), frame()?, &settings.mffd),
+        })),
+        Method::Hybrid => Ok(Arc::new(MffdWarp {
+            mffd: hybrid::solve(&pairs(), frame()?, &settings.hybrid),
+        })),
         Method::Auto => {
             let c = settings.correspondence.as_ref().ok_or_else(|| {
                 Error::Invalid(
                     "method \"auto\" needs both images: its correspondence is solved from A and B (the Morph node, morphfx morph)".into(),
                 )
             })?;
-            Ok(Arc::new(c.toward(side, t)))
+            Ok(Arc::new(c.toward(side, tween)))
         }
-        m => Err(Error::Unsupported(format!(
-            "method \"{}\" is not available in this build yet (available: {})",
-            m.name(),
-            Method::available_names()
-        ))),
     }
+}
+
+impl WarpSettings {
+    /// The geometry transition's rates at `t` (uniform unless the scene
+    /// asks otherwise), over the frame or the features' bounds.
+    pub fn geometry_rates(&self, features: &[Feature], t: f64) -> Result<Rates> {
+        self.rates(&self.transition.geometry, features, t)
+    }
+
+    /// The colour transition's rates at `t`.
+    pub fn colour_rates(&self, features: &[Feature], t: f64) -> Result<Rates> {
+        self.rates(self.transition.colour(), features, t)
+    }
+
+    fn rates(
+        &self,
+        transition: &crate::transition::Transition,
+        features: &[Feature],
+        t: f64,
+    ) -> Result<Rates> {
+        if *transition == crate::transition::Transition::Uniform {
+            return Ok(Rates::Uniform(t));
+        }
+        let frame = self
+            .frame
+            .or_else(|| feature_bounds(features))
+            .unwrap_or(RectD::new(0.0, 0.0, 1.0, 1.0));
+        transition.rates(features, self.samples_per_segment, frame, t)
+    }
+}
+
+/// Every feature's corresponding points (polylines and curves sampled
+/// `per_segment` times per span, seed 000 §4.2) as `(in-between, source)`
+/// pairs for the scattered-data methods: the reverse map carries each
+/// in-between position to its place on `side`.
+pub fn point_pairs_toward(
+    features: &[Feature],
+    side: Side,
+    t: Tween<'_>,
+    per_segment: usize,
+) -> Vec<(Vec2, Vec2)> {
+    features
+        .iter()
+        .flat_map(|f| f.point_pairs(per_segment))
+        .map(|pair| {
+            let source = match side {
+                Side::A => pair.a,
+                Side::B => pair.b,
+            };
+            (t.between(pair.a, pair.b), source)
+        })
+        .collect()
 }
 
 /// The bounds of every feature point on both sides, grown by half their size

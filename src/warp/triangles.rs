@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use crate::error::{Error, Result};
-use crate::features::{Feature, Side};
+use crate::features::{Feature, Side, Tween};
 use crate::geom::{PixelScale, RectD, RectI, Vec2};
 use crate::warp::{Warp, WarpMap};
 
@@ -109,10 +109,10 @@ impl TriangleWarp {
     /// Triangulates every feature's points (polylines and curves sampled
     /// `per_segment` times per span, seed 000 §4.2) with the border of `frame`.
     /// Where two features meet at one in-between position, the first wins.
-    pub fn toward(
+    pub fn toward<'a>(
         features: &[Feature],
         side: Side,
-        t: f64,
+        t: impl Into<Tween<'a>>,
         per_segment: usize,
         frame: RectD,
     ) -> Result<TriangleWarp> {
@@ -121,6 +121,7 @@ impl TriangleWarp {
                 "triangles: the frame {frame:?} is empty or not finite"
             )));
         }
+        let t = t.into();
         let mut nodes = Vec::new();
         for f in features {
             for pair in f.point_pairs(per_segment) {
@@ -128,7 +129,7 @@ impl TriangleWarp {
                     Side::A => pair.a,
                     Side::B => pair.b,
                 };
-                nodes.push((pair.a.lerp(pair.b, t), source));
+                nodes.push((t.between(pair.a, pair.b), source));
             }
         }
         for k in 0..BORDER_POINTS - 1 {

@@ -250,13 +250,6 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         );
     }
     let mut frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
-    if !frame.warp.method.is_available() {
-        return Err(Failure::BadInput(format!(
-            "method \"{}\" is not available in this build yet (available: {})",
-            frame.warp.method.name(),
-            morphfx::scene::Method::available_names()
-        )));
-    }
 
     let (a_name, b_name) = kind.source_clips(&context);
     let a_img = source(effect, a_name, time + settings.offset_a as f64)?;

@@ -22,7 +22,7 @@ pub use quad_warp::QuadWarp;
 pub use work::{Anchor, Coefficients, Pricer, Work, WorkImage, ANCHOR_FLOOR_PX};
 
 use crate::error::{Error, Result};
-use crate::features::{Feature, Side};
+use crate::features::{Feature, Side, Tween};
 use crate::geom::{RectD, Vec2};
 
 /// Scene key `auto`.
@@ -230,8 +230,8 @@ impl Correspondence {
     }
 
     /// The warp of `side` toward the in-between at `t`.
-    pub fn toward(&self, side: Side, t: f64) -> QuadWarp {
-        QuadWarp::toward(&self.grid, self.a_frame, self.b_frame, side, t)
+    pub fn toward<'a>(&self, side: Side, t: impl Into<Tween<'a>>) -> QuadWarp {
+        QuadWarp::toward(&self.grid, self.a_frame, self.b_frame, side, t.into())
     }
 
     /// `F` on canonical points of A.

@@ -3,7 +3,7 @@
 //! blend, and a pixel of the in-between finds its quad, its patch coordinates
 //! (inverse bilinear) and their place on the source side.
 
-use crate::features::Side;
+use crate::features::{Side, Tween};
 use crate::geom::{RectD, Vec2};
 use crate::warp::Warp;
 
@@ -31,7 +31,13 @@ pub struct QuadWarp {
 impl QuadWarp {
     /// The warp of `side` toward the blend at `t` of the two meshes `a`, `b`
     /// (the same grid's points in A's and B's canonical pixels).
-    pub fn toward(grid: &Grid, a_frame: RectD, b_frame: RectD, side: Side, t: f64) -> QuadWarp {
+    pub fn toward(
+        grid: &Grid,
+        a_frame: RectD,
+        b_frame: RectD,
+        side: Side,
+        t: Tween<'_>,
+    ) -> QuadWarp {
         let place = |f: RectD, p: Vec2| Vec2::new(f.x1 + p.x * f.width(), f.y1 + p.y * f.height());
         let n = grid.n();
         let a: Vec<Vec2> = (0..=n)
@@ -39,7 +45,7 @@ impl QuadWarp {
             .map(|p| place(a_frame, p))
             .collect();
         let b: Vec<Vec2> = grid.points().iter().map(|&p| place(b_frame, p)).collect();
-        let to: Vec<Vec2> = a.iter().zip(&b).map(|(&p, &q)| p.lerp(q, t)).collect();
+        let to: Vec<Vec2> = a.iter().zip(&b).map(|(&p, &q)| t.between(p, q)).collect();
         let from = match side {
             Side::A => a,
             Side::B => b,

@@ -1,7 +1,7 @@
 //! Features as Beier-Neely line pairs, and lines interpolated over `t`.
 
 use super::{FieldSettings, LineInterpolation};
-use crate::features::{sample_points, Feature, FeatureKind, Side};
+use crate::features::{sample_points, Feature, FeatureKind, Side, Tween};
 use crate::geom::Vec2;
 
 /// A directed segment in the output (`dst`) and where it comes from in the
@@ -13,6 +13,8 @@ pub struct LinePair {
 }
 
 /// The line pairs that warp the image on `side` toward the features at `t`.
+/// With per-point rates, `endpoints` moves each end at its own rate and
+/// `center-angle` moves the line at the mean of its ends' rates.
 ///
 /// Polylines give one line per segment and curves one per sample interval.
 /// A point becomes a unit-length horizontal line on both sides: with equal
@@ -21,7 +23,7 @@ pub struct LinePair {
 pub fn line_pairs_toward(
     features: &[Feature],
     side: Side,
-    t: f64,
+    t: Tween<'_>,
     settings: &FieldSettings,
 ) -> Vec<LinePair> {
     let mut pairs = Vec::new();
@@ -31,7 +33,12 @@ pub fn line_pairs_toward(
             segments(f, Side::B, settings),
         );
         for (sa, sb) in a.into_iter().zip(b) {
-            let dst = interpolate_line(sa, sb, t, settings.interpolation);
+            let (r0, r1) = (t.rate(sa.0), t.rate(sa.1));
+            let dst = match settings.interpolation {
+                _ if r0 == r1 => interpolate_line(sa, sb, r0, settings.interpolation),
+                LineInterpolation::Endpoints => (t.between(sa.0, sb.0), t.between(sa.1, sb.1)),
+                mode => interpolate_line(sa, sb, 0.5 * (r0 + r1), mode),
+            };
             let src = match side {
                 Side::A => sa,
                 Side::B => sb,

@@ -8,7 +8,7 @@ pub mod weight;
 
 pub use lines::{interpolate_line, line_pairs_toward, LinePair};
 
-use crate::features::{Feature, Side};
+use crate::features::{Feature, Side, Tween};
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::warp::{Warp, WarpMap};
 use weight::Weight;
@@ -115,8 +115,16 @@ impl FieldWarp {
 
     /// The warp of the image on `side` toward the features' positions at `t`
     /// (output lines at `t`, source lines on that side).
-    pub fn toward(features: &[Feature], side: Side, t: f64, settings: &FieldSettings) -> Self {
-        FieldWarp::new(line_pairs_toward(features, side, t, settings), settings)
+    pub fn toward<'a>(
+        features: &[Feature],
+        side: Side,
+        t: impl Into<Tween<'a>>,
+        settings: &FieldSettings,
+    ) -> Self {
+        FieldWarp::new(
+            line_pairs_toward(features, side, t.into(), settings),
+            settings,
+        )
     }
 
     pub fn pairs(&self) -> &[LinePair] {

@@ -19,7 +19,7 @@ pub use patch::MeshWarp;
 pub use two_pass::{two_pass, two_pass_into};
 
 use crate::error::{Error, Result};
-use crate::features::Side;
+use crate::features::{Side, Tween};
 use crate::geom::Vec2;
 
 /// A grid of control points, `rows × cols`, row by row from the bottom row
@@ -246,6 +246,15 @@ impl MeshPair {
     /// The in-between mesh at `t` (seed 001 `morph`: nodes interpolated linearly).
     pub fn at(&self, t: f64) -> Mesh {
         self.a.lerp(&self.b, t)
+    }
+
+    /// The in-between mesh with each node at its own rate (transition control:
+    /// Smythe's per-node transition curves, seed 003 §1).
+    pub fn tween(&self, t: Tween<'_>) -> Mesh {
+        if t.is_uniform() {
+            return self.at(t.t);
+        }
+        self.a.map_nodes(|r, c, p| t.between(p, self.b.node(r, c)))
     }
 
     /// Node for node interpolation between two keyed pairs (sequence keyframes).

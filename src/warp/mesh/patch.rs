@@ -8,7 +8,7 @@
 use rayon::prelude::*;
 
 use super::{Mesh, MeshPair};
-use crate::features::Side;
+use crate::features::{Side, Tween};
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::warp::{Warp, WarpMap};
 
@@ -224,8 +224,8 @@ impl MeshWarp {
     }
 
     /// The warp of the image on `side` toward the in-between mesh at `t`.
-    pub fn toward(pair: &MeshPair, side: Side, t: f64) -> MeshWarp {
-        MeshWarp::new(pair.side(side), &pair.at(t))
+    pub fn toward<'a>(pair: &MeshPair, side: Side, t: impl Into<Tween<'a>>) -> MeshWarp {
+        MeshWarp::new(pair.side(side), &pair.tween(t.into()))
     }
 
     /// `p` mapped, starting Newton at `guess`; returns the parameters used so

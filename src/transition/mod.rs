@@ -1,0 +1,285 @@
+//! Transition control (seed 000 §3 and §6, seed 003 §3.3): how fast each
+//! point of A travels toward its place on B (geometry) and how fast its colour
+//! gives way to B's (colour), as a rate `T0(p; t) ∈ [0, 1]` per point of A.
+//!
+//! A rate comes from transition curves attached to features or points of A,
+//! propagated over the image by multilevel B-spline interpolation (or by the
+//! thin plate), or from a procedural pattern. On B the rate is `T1(q; t) =
+//! T0(W1(q); t)`, `W1` the warp that carries B onto A, so both images agree
+//! on every pair of corresponding points.
+
+pub mod curve;
+pub mod procedural;
+
+use rayon::prelude::*;
+
+use crate::bspline::mba::{self, MbaSettings};
+use crate::bspline::Lattice;
+use crate::error::{Error, Result};
+use crate::features::{Feature, Side};
+use crate::geom::{RectD, RectI, Vec2};
+use crate::warp::node_grid::NodeGrid;
+use crate::warp::thin_plate::{ThinPlate, ThinPlateSettings};
+use crate::warp::{Warp, WarpMap};
+pub use curve::Curve;
+pub use procedural::{Pattern, Procedural};
+
+/// Where a transition curve is attached on A.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Attach {
+    /// Every point of the feature with this name shares the curve.
+    Name(String),
+    /// Every point of the feature at this index of the feature list.
+    Index(usize),
+    /// One point (canonical, on A).
+    At(Vec2),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attached {
+    pub attach: Attach,
+    pub curve: Curve,
+}
+
+/// How the curves' rates spread over the image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Propagation {
+    /// Multilevel B-spline interpolation (seed 000 §6.2): C².
+    BSpline(MbaSettings),
+    /// The thin plate (seed 003 §3.3): C¹.
+    ThinPlate(ThinPlateSettings),
+}
+
+impl Default for Propagation {
+    fn default() -> Self {
+        Propagation::BSpline(MbaSettings::default())
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum Transition {
+    /// Every point at rate `t`.
+    #[default]
+    Uniform,
+    Curves {
+        curves: Vec<Attached>,
+        propagation: Propagation,
+    },
+    Procedural(Procedural),
+}
+
+/// The geometry transition, and the colour one (`None`: the same as the
+/// geometry, as seed 000 §3 treats them).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TransitionSettings {
+    pub geometry: Transition,
+    pub colour: Option<Transition>,
+}
+
+impl TransitionSettings {
+    pub fn colour(&self) -> &Transition {
+        self.colour.as_ref().unwrap_or(&self.geometry)
+    }
+}
+
+/// `T0(·; t)` at one instant: the rate of every point of A.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Rates {
+    Uniform(f64),
+    Procedural {
+        procedural: Procedural,
+        frame: RectD,
+        t: f64,
+    },
+    /// `t + ΔT(p)`, `ΔT` a B-spline surface.
+    Surface {
+        t: f64,
+        delta: Lattice,
+    },
+    /// `t + ΔT(p)`, `ΔT` a thin plate.
+    Plate {
+        t: f64,
+        delta: NodeGrid,
+    },
+}
+
+impl Rates {
+    /// The rate of the point at `p` on A, in `[0, 1]`.
+    #[inline]
+    pub fn at(&self, p: Vec2) -> f64 {
+        let r = match self {
+            Rates::Uniform(t) => return *t,
+            Rates::Procedural {
+                procedural,
+                frame,
+                t,
+            } => return procedural.rate(p, *frame, *t),
+            Rates::Surface { t, delta } => t + delta.eval(p),
+            Rates::Plate { t, delta } => t + delta.displacement(p).x,
+        };
+        r.clamp(0.0, 1.0)
+    }
+
+    /// The progress these rates are for.
+    pub fn t(&self) -> f64 {
+        match self {
+            Rates::Uniform(t)
+            | Rates::Procedural { t, .. }
+            | Rates::Surface { t, .. }
+            | Rates::Plate { t, .. } => *t,
+        }
+    }
+
+    /// `Some(t)` when every point has rate `t`.
+    pub fn uniform(&self) -> Option<f64> {
+        match self {
+            Rates::Uniform(t) => Some(*t),
+            _ => None,
+        }
+    }
+}
+
+impl Transition {
+    /// The rates at progress `t` for the features of this frame (curves
+    /// attached to features follow them; polylines and curves sampled
+    /// `per_segment` times per span) over `frame` (canonical, A).
+    pub fn rates(
+        &self,
+        features: &[Feature],
+        per_segment: usize,
+        frame: RectD,
+        t: f64,
+    ) -> Result<Rates> {
+        if t <= 0.0 || t >= 1.0 {
+            return Ok(Rates::Uniform(t.clamp(0.0, 1.0)));
+        }
+        match self {
+            Transition::Uniform => Ok(Rates::Uniform(t)),
+            Transition::Procedural(procedural) => Ok(if procedural.spread == 0.0 {
+                Rates::Uniform(t)
+            } else {
+                Rates::Procedural {
+                    procedural: *procedural,
+                    frame,
+                    t,
+                }
+            }),
+            Transition::Curves {
+                curves,
+                propagation,
+            } => {
+                let points = constraints(curves, features, per_segment, t)?;
+                if points.iter().all(|(_, d)| *d == 0.0) {
+                    return Ok(Rates::Uniform(t));
+                }
+                let (mut min, mut max) =
+                    (Vec2::new(frame.x1, frame.y1), Vec2::new(frame.x2, frame.y2));
+                for (p, _) in &points {
+                    min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
+                    max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
+                }
+                Ok(match propagation {
+                    Propagation::BSpline(s) => Rates::Surface {
+                        t,
+                        delta: mba::interpolate(&points, min, max, s).lattice,
+                    },
+                    Propagation::ThinPlate(s) => {
+                        let pairs: Vec<(Vec2, Vec2)> = points
+                            .iter()
+                            .map(|(p, d)| (*p, *p + Vec2::new(*d, 0.0)))
+                            .collect();
+                        let area = RectD::new(min.x, min.y, max.x, max.y);
+                        Rates::Plate {
+                            t,
+                            delta: ThinPlate::solve(&pairs, area, s, None).nodes,
+                        }
+                    }
+                })
+            }
+        }
+    }
+}
+
+/// The curves' points on A and what each asks of the surface, `C(t) − t`
+/// (seed 003 §3.3: `ΔT = C − t`, so `T0 = t + ΔT`).
+pub fn constraints(
+    curves: &[Attached],
+    features: &[Feature],
+    per_segment: usize,
+    t: f64,
+) -> Result<Vec<(Vec2, f64)>> {
+    let mut points = Vec::new();
+    for (k, c) in curves.iter().enumerate() {
+        let delta = c.curve.at(t) - t;
+        let feature = match &c.attach {
+            Attach::At(p) => {
+                points.push((*p, delta));
+                continue;
+            }
+            Attach::Name(name) => features.iter().find(|f| f.name.as_deref() == Some(name)),
+            Attach::Index(i) => features.get(*i),
+        };
+        let f = feature.ok_or_else(|| {
+            Error::scene(
+                format!("transition curves[{k}]"),
+                format!("{:?}: no such feature in this frame", c.attach),
+            )
+        })?;
+        points.extend(
+            f.sampled(Side::A, per_segment)
+                .into_iter()
+                .map(|p| (p, delta)),
+        );
+    }
+    Ok(points)
+}
+
+/// Per-pixel weights of the dissolve (seed 000 §3): A's colour attenuated by
+/// `1 − T0` at the point it comes from, B's by `T1 = T0 ∘ W1` at its point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Weights {
+    pub window: RectI,
+    pub a: Vec<f32>,
+    pub b: Vec<f32>,
+}
+
+impl Weights {
+    pub fn memory_bytes(&self) -> usize {
+        (self.a.len() + self.b.len()) * 4
+    }
+}
+
+/// The weights over the window of `map_a` (which `map_b` shares). `w1`
+/// carries points of B to their correspondents on A.
+pub fn colour_weights(rates: &Rates, map_a: &WarpMap, map_b: &WarpMap, w1: &dyn Warp) -> Weights {
+    let window = map_a.window;
+    let w = window.width();
+    let mut a = vec![0f32; window.area()];
+    let mut b = vec![0f32; window.area()];
+    if w > 0 {
+        a.par_chunks_mut(w)
+            .zip(b.par_chunks_mut(w))
+            .enumerate()
+            .for_each_init(
+                || (vec![0f32; w], vec![0f32; w], vec![0f32; w], vec![0f32; w]),
+                |(xs, ys, ox, oy), (row, (wa, wb))| {
+                    let j = window.y1 + row as i32;
+                    for (k, o) in wa.iter_mut().enumerate() {
+                        let i = window.x1 + k as i32;
+                        *o = (1.0 - rates.at(map_a.get(i, j))) as f32;
+                        let q = map_b.get(i, j);
+                        xs[k] = q.x as f32;
+                        ys[k] = q.y as f32;
+                    }
+                    w1.map_points(xs, ys, ox, oy);
+                    for (k, o) in wb.iter_mut().enumerate() {
+                        *o = rates.at(Vec2::new(ox[k] as f64, oy[k] as f64)) as f32;
+                    }
+                },
+            );
+    }
+    Weights { window, a, b }
+}
+
+#[cfg(test)]
+mod tests;

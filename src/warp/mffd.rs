@@ -1,0 +1,269 @@
+//! Multilevel free-form deformation (seed 000 §5): one-to-one warps from
+//! scattered point pairs.
+//!
+//! Each step is a cubic B-spline FFD whose control displacements come from the
+//! least-squares rule (eq. 4–5) and are truncated to `0.48 h` per coordinate,
+//! which by Theorem 1 makes the step one-to-one with a positive Jacobian. The
+//! warp is the composition of the steps, so it is one-to-one whatever the
+//! constraints ask (swapped or crossing points end as close as folding-free
+//! allows, seed Fig. 14). Steps start on a coarse lattice and move to the next
+//! finer one when a step gains less than `α (0.48 h)²` in squared error (§5.4).
+
+use super::node_grid::NodeGrid;
+use super::{Warp, WarpMap};
+use crate::bspline::{Approximation, Lattice};
+use crate::geom::{PixelScale, RectD, RectI, Vec2};
+
+/// Theorem 1's bound on a control displacement, in lattice spacings.
+pub const ONE_TO_ONE_BOUND: f64 = 0.48;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MffdSettings {
+    /// Cells of the coarsest lattice across the longer side of the frame
+    /// (seed: a 5 × 5 lattice, two cells).
+    pub coarsest: usize,
+    /// `α` of §5.4: a step that gains less than `α (0.48 h)²` moves to the
+    /// next finer lattice. Small values favour coarse, smooth deformation.
+    pub alpha: f64,
+    /// Stop once every constraint is within this distance (canonical px).
+    pub tolerance: f64,
+    /// The finest lattice spacing (canonical px).
+    pub finest: f64,
+    /// Spacing (output pixels) of the nodes where the composition is
+    /// evaluated exactly for a dense map; bilinear between them.
+    pub grid: f64,
+    /// Theorem 1's truncation. Off only to show what it prevents.
+    pub truncate: bool,
+}
+
+impl Default for MffdSettings {
+    fn default() -> Self {
+        MffdSettings {
+            coarsest: 2,
+            alpha: 0.5,
+            tolerance: 0.01,
+            finest: 1.0,
+            grid: 2.0,
+            truncate: true,
+        }
+    }
+}
+
+/// Most steps one solve takes (foldover-prone constraints may never meet
+/// the tolerance; each step is then still one-to-one).
+const MAX_STEPS: usize = 96;
+
+/// One FFD: `p ↦ p + (dx(p), dy(p))`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deformation {
+    pub dx: Lattice,
+    pub dy: Lattice,
+    /// Cells whose 16 controls are not all zero (cell `c` at index `c + 2`),
+    /// so evaluation skips the rest of the plane; `None` when `dx` and `dy`
+    /// differ in geometry (then every point is evaluated).
+    active: Option<Vec<bool>>,
+}
+
+impl Deformation {
+    pub fn new(dx: Lattice, dy: Lattice) -> Self {
+        if (dx.origin, dx.h, dx.nx, dx.ny) != (dy.origin, dy.h, dy.nx, dy.ny) {
+            return Deformation {
+                dx,
+                dy,
+                active: None,
+            };
+        }
+        let (nx, ny) = (dx.nx, dx.ny);
+        let (cx, cy) = (nx + 3, ny + 3);
+        let mut active = vec![false; cx * cy];
+        for j in 0..ny {
+            for i in 0..nx {
+                let k = j * nx + i;
+                if dx.phi[k] != 0.0 || dy.phi[k] != 0.0 {
+                    // Control i is read by cells i−2 ..= i+1, stored at +2.
+                    for r in j..j + 4 {
+                        for c in i..i + 4 {
+                            active[r * cx + c] = true;
+                        }
+                    }
+                }
+            }
+        }
+        Deformation {
+            dx,
+            dy,
+            active: Some(active),
+        }
+    }
+
+    #[inline]
+    fn is_active(&self, p: Vec2) -> bool {
+        let Some(active) = &self.active else {
+            return true;
+        };
+        let (c, r, _, _) = self.dx.locate(p);
+        let (cx, cy) = (self.dx.nx as i64 + 3, self.dx.ny as i64 + 3);
+        let (c, r) = (c + 2, r + 2);
+        c >= 0 && r >= 0 && c < cx && r < cy && active[(r * cx + c) as usize]
+    }
+
+    #[inline]
+    pub fn apply(&self, p: Vec2) -> Vec2 {
+        if !self.is_active(p) {
+            return p;
+        }
+        p + Vec2::new(self.dx.eval(p), self.dy.eval(p))
+    }
+
+    /// The Jacobian `[[∂x/∂u, ∂x/∂v], [∂y/∂u, ∂y/∂v]]` at `p`.
+    pub fn jacobian(&self, p: Vec2) -> [[f64; 2]; 2] {
+        let (gx, gy) = (self.dx.gradient(p), self.dy.gradient(p));
+        [[1.0 + gx.x, gx.y], [gy.x, 1.0 + gy.y]]
+    }
+
+    /// The largest control displacement in lattice spacings (`|Δφ|∞ / h`).
+    pub fn largest_step(&self) -> f64 {
+        let m = self
+            .dx
+            .phi
+            .iter()
+            .chain(&self.dy.phi)
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        m / self.dx.h
+    }
+}
+
+/// A solved MFFD: its steps (applied first to last) and what it reached.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mffd {
+    pub steps: Vec<Deformation>,
+    /// Largest distance from a constraint's target after the last step.
+    pub error: f64,
+    grid: f64,
+}
+
+impl Mffd {
+    /// Moves every `from` onto its `to` (`pairs`), over `frame`.
+    pub fn solve(pairs: &[(Vec2, Vec2)], frame: RectD, s: &MffdSettings) -> Mffd {
+        let extent = frame.width().max(frame.height()).max(1.0);
+        Mffd::solve_from(
+            Vec::new(),
+            pairs,
+            frame,
+            extent / s.coarsest.max(1) as f64,
+            s,
+        )
+    }
+
+    /// As [`Mffd::solve`], after the deformations `first` (hybrid: the thin
+    /// plate's warp) and starting on lattices of spacing `h0`.
+    pub fn solve_from(
+        first: Vec<Deformation>,
+        pairs: &[(Vec2, Vec2)],
+        frame: RectD,
+        h0: f64,
+        s: &MffdSettings,
+    ) -> Mffd {
+        let targets: Vec<Vec2> = pairs.iter().map(|(_, q)| *q).collect();
+        let mut at: Vec<Vec2> = pairs
+            .iter()
+            .map(|(p, _)| first.iter().fold(*p, |p, d| d.apply(p)))
+            .collect();
+        let sq_error = |at: &[Vec2]| {
+            at.iter()
+                .zip(&targets)
+                .fold(0.0f64, |m, (p, q)| m.max((*q - *p).length_squared()))
+        };
+        let mut steps = first;
+        let mut h = h0.max(s.finest);
+        let mut error = sq_error(&at);
+        let tolerance = s.tolerance * s.tolerance;
+        while error > tolerance && steps.len() < MAX_STEPS {
+            let step = ffd_step(&at, &targets, frame, h, s.truncate);
+            for p in at.iter_mut() {
+                *p = step.apply(*p);
+            }
+            steps.push(step);
+            let old = error;
+            error = sq_error(&at);
+            let gain = old - error;
+            let bound = ONE_TO_ONE_BOUND * h;
+            if gain < s.alpha * bound * bound {
+                if h / 2.0 >= s.finest {
+                    h /= 2.0;
+                } else if gain <= 1e-6 * old {
+                    break; // finest lattice and no progress: as close as one-to-one allows
+                }
+            }
+        }
+        Mffd {
+            steps,
+            error: error.sqrt(),
+            grid: s.grid,
+        }
+    }
+
+    /// The composed warp at `p`, exactly.
+    pub fn apply(&self, p: Vec2) -> Vec2 {
+        self.steps.iter().fold(p, |p, d| d.apply(p))
+    }
+
+    /// The Jacobian determinant of the composition at `p` (chain rule).
+    pub fn jacobian_det(&self, p: Vec2) -> f64 {
+        let mut det = 1.0;
+        let mut q = p;
+        for d in &self.steps {
+            let j = d.jacobian(q);
+            det *= j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            q = d.apply(q);
+        }
+        det
+    }
+}
+
+/// One FFD manipulation (seed 000 §5.3's algorithm) on a lattice of spacing `h`
+/// that covers the frame and every point.
+fn ffd_step(at: &[Vec2], targets: &[Vec2], frame: RectD, h: f64, truncate: bool) -> Deformation {
+    let (mut min, mut max) = (Vec2::new(frame.x1, frame.y1), Vec2::new(frame.x2, frame.y2));
+    for p in at.iter().chain(targets) {
+        min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
+        max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
+    }
+    let lattice = Lattice::covering(min, max, h);
+    let mut fit = Approximation::new(&lattice);
+    for (p, q) in at.iter().zip(targets) {
+        fit.add(*p, *q - *p);
+    }
+    let (dx, dy) = fit.finish(truncate.then_some(ONE_TO_ONE_BOUND * h));
+    Deformation::new(dx, dy)
+}
+
+/// The reverse map of an MFFD. Pointwise it is the exact composition; a
+/// dense map composes exactly at nodes `grid` output pixels apart and is
+/// bilinear between them.
+#[derive(Debug, Clone)]
+pub struct MffdWarp {
+    pub mffd: Mffd,
+}
+
+impl Warp for MffdWarp {
+    fn map(&self, p: Vec2) -> Vec2 {
+        self.mffd.apply(p)
+    }
+
+    fn is_identity(&self) -> bool {
+        self.mffd.steps.is_empty()
+    }
+
+    fn map_window(&self, window: RectI, scale: PixelScale) -> WarpMap {
+        if self.is_identity() {
+            return WarpMap::identity(window, scale);
+        }
+        let lo = scale.pixel_centre(window.x1, window.y1);
+        let hi = scale.pixel_centre(window.x2 - 1, window.y2 - 1);
+        let unit = scale.pixel_centre(1, 1) - scale.pixel_centre(0, 0);
+        let mut nodes = NodeGrid::covering(lo, hi, unit * self.mffd.grid.max(1.0));
+        nodes.fill(|p| self.mffd.apply(p));
+        nodes.map_window(window, scale)
+    }
+}
