@@ -24,6 +24,12 @@ impl Weigh for WarpMap {
     }
 }
 
+impl Weigh for morphfx::transition::Weights {
+    fn bytes(&self) -> usize {
+        self.memory_bytes()
+    }
+}
+
 impl Weigh for Correspondence {
     fn bytes(&self) -> usize {
         std::mem::size_of_val(self.grid.points())

@@ -252,22 +252,23 @@ fn transition(raw: RawTransition, at: &str, features: &[Feature]) -> Result<Tran
             refuse(&curve_keys)?;
             let cycles = in_range(raw.cycles, 2.0, 0.0..=100.0, &format!("{at}.cycles"))?;
             let angle = in_range(raw.angle, 0.0, -360.0..=360.0, &format!("{at}.angle"))?;
-            let pattern =
-                match raw.pattern.as_deref().unwrap_or("ramp") {
-                    "ramp" => Pattern::Ramp { angle },
-                    "sine-rows" => Pattern::SineRows { cycles },
-                    "sine-columns" => Pattern::SineColumns { cycles },
-                    "radial" => Pattern::Radial {
-                        cycles: in_range(raw.cycles, 0.0, 0.0..=100.0, &format!("{at}.cycles"))?,
-                        centre: raw.centre.map(Vec2::from),
-                    },
-                    other => return Err(Error::scene(
+            let pattern = match raw.pattern.as_deref().unwrap_or("ramp") {
+                "ramp" => Pattern::Ramp { angle },
+                "sine-rows" => Pattern::SineRows { cycles },
+                "sine-columns" => Pattern::SineColumns { cycles },
+                "radial" => Pattern::Radial {
+                    cycles: in_range(raw.cycles, 0.0, 0.0..=100.0, &format!("{at}.cycles"))?,
+                    centre: raw.centre.map(Vec2::from),
+                },
+                other => {
+                    return Err(Error::scene(
                         format!("{at}.pattern"),
                         format!(
                             "unknown pattern \"{other}\" (ramp, sine-rows, sine-columns, radial)"
                         ),
-                    )),
-                };
+                    ))
+                }
+            };
             if let Some(c) = raw.centre {
                 if !matches!(pattern, Pattern::Radial { .. }) {
                     return Err(Error::scene(

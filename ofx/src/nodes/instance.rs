@@ -5,6 +5,7 @@ use std::sync::{Arc, Mutex};
 
 use morphfx::image::Plane;
 use morphfx::scene::Scene;
+use morphfx::transition::Weights;
 use morphfx::warp::auto::{Correspondence, Grid};
 
 use crate::cache::{Cache, WarpCache};
@@ -26,6 +27,9 @@ pub struct Instance {
     /// The last solved `auto` grids by frame, for warm starts: `(time,
     /// settings key, grid)`, at most [`GRIDS_KEPT`].
     pub grids: Mutex<Vec<(f64, u64, Grid)>>,
+    /// Per-pixel dissolve weights of non-uniform colour transitions, keyed
+    /// like the warps they come from.
+    pub weights: Cache<Weights>,
 }
 
 /// Solved grids kept for warm starts.
@@ -43,6 +47,7 @@ impl Instance {
             .unwrap_or_else(|e| e.into_inner())
             .clear();
         self.correspondences.clear();
+        self.weights.clear();
         self.grids.lock().unwrap_or_else(|e| e.into_inner()).clear();
     }
 

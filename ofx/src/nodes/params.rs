@@ -4,11 +4,14 @@ use morphfx::features::Feature;
 use morphfx::geom::Vec2;
 use morphfx::image::{EdgeMode, Filter};
 use morphfx::scene::Method;
+use morphfx::transition::{Pattern, Procedural, Transition, TransitionSettings};
 use morphfx::views::View;
 use morphfx::warp::auto::grid::MAX_LEVEL;
 use morphfx::warp::auto::{AutoSettings, Coefficients};
 use morphfx::warp::field::{Evaluation, FieldSettings, LineInterpolation};
 use morphfx::warp::mesh::{MeshSettings, Pass};
+use morphfx::warp::mffd::MffdSettings;
+use morphfx::warp::thin_plate::ThinPlateSettings;
 
 use super::spec::{Kind, ParamSpec, TextMode};
 use super::NodeKind;
@@ -44,6 +47,17 @@ pub const AUTO_STRETCH: &str = "auto_stretch";
 pub const AUTO_ANGLE: &str = "auto_angle";
 pub const AUTO_ANCHORS: &str = "auto_anchors";
 pub const AUTO_WARM_START: &str = "auto_warm_start";
+pub const PLATE_ALPHA: &str = "plate_alpha";
+pub const PLATE_BETA: &str = "plate_beta";
+pub const MFFD_ALPHA: &str = "mffd_alpha";
+pub const TRANSITION: &str = "transition";
+pub const TRANSITION_AFFECTS: &str = "transition_affects";
+pub const TRANSITION_SPREAD: &str = "transition_spread";
+pub const TRANSITION_ANGLE: &str = "transition_angle";
+pub const TRANSITION_CYCLES: &str = "transition_cycles";
+
+/// The procedural transitions the node offers (curves come from the scene).
+const TRANSITIONS: [&str; 5] = ["uniform", "ramp", "sine-rows", "sine-columns", "radial"];
 
 /// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
 pub fn slot_ids(k: usize) -> [String; 5] {
@@ -90,8 +104,9 @@ fn view_label(kind: NodeKind, v: View) -> &'static str {
 pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
     let d = FieldSettings::default();
     let c = Coefficients::default();
+    let tp = ThinPlateSettings::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; auto: the least-work warp of A onto B found from the images (Morph node only), features acting as anchors. Methods marked not yet available refuse to render.", Kind::Choice { options: method_options(), default: 0 }),
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs (seed 003); mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto: the least-work warp of A onto B found from the images (Morph node only), features acting as anchors.", Kind::Choice { options: method_options(), default: 0 }),
         ParamSpec::new(
             PROGRESS,
             "Progress",
@@ -116,6 +131,16 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(AUTO_ANGLE, "Angle Work", "Weight of angle-change work (c_a).", Kind::Double { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
         ParamSpec::new(AUTO_ANCHORS, "Anchor Weight", "How strongly features (line slots, scene features) hold as anchor points.", Kind::Double { default: c.anchor, min: 0.0, max: 1000.0, display: (0.0, 100.0) }).in_group("auto_group").animated(false),
         ParamSpec::new(AUTO_WARM_START, "Warm Start", "Start each frame from the previous frame's warp when this instance has it: faster, steadier over a sequence; off makes every frame independent of render order.", Kind::Bool { default: true }).in_group("auto_group").animated(false),
+        ParamSpec::new("scattered_group", "Thin Plate / MFFD", "Settings of the scattered-feature methods (thin-plate, mffd, hybrid)", Kind::Group { open: false }),
+        ParamSpec::new(PLATE_ALPHA, "Spring α", "How tightly the thin plate meets the feature points (px⁻²). Larger is tighter and slower to solve.", Kind::Double { default: tp.alpha, min: 0.01, max: 1e6, display: (1.0, 1000.0) }).in_group("scattered_group").animated(false),
+        ParamSpec::new(PLATE_BETA, "Glue β", "How soon a feature's pull dies away in the thin plate (px⁻⁴): it reaches about β^(-1/4) px. 0: no glue, the pull spreads over the frame.", Kind::Double { default: tp.beta, min: 0.0, max: 1.0, display: (0.0, 1e-4) }).in_group("scattered_group").animated(false),
+        ParamSpec::new(MFFD_ALPHA, "Refine α", "MFFD moves to a finer lattice when a step gains less than α (0.48 h)²: small values keep the deformation coarse and smooth.", Kind::Double { default: MffdSettings::default().alpha, min: 0.0, max: 1.0, display: (0.0, 1.0) }).in_group("scattered_group").animated(false),
+        ParamSpec::new("transition_group", "Transition", "How fast each part changes (transition curves come from the scene's \"transition\" key)", Kind::Group { open: false }),
+        ParamSpec::new(TRANSITION, "Transition", "uniform: every pixel at Progress; ramp, sine-rows, sine-columns, radial: each pixel's turn comes from where it is on A, every pixel still exactly A at 0 and B at 1.", Kind::Choice { options: TRANSITIONS.to_vec(), default: 0 }).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_AFFECTS, "Affects", "What the transition paces: the geometry (where features are) and the colour (the dissolve), or one of them (the other stays uniform).", Kind::Choice { options: vec!["geometry and colour", "geometry", "colour"], default: 0 }).in_group("transition_group").animated(false),
+        ParamSpec::new(TRANSITION_SPREAD, "Spread", "Share of the progress over which the pattern sweeps: 0 is uniform; near 1 each pixel changes almost at once, at its turn.", Kind::Double { default: 0.5, min: 0.0, max: 0.99, display: (0.0, 0.99) }).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_ANGLE, "Angle", "Direction of the ramp in degrees: 0 left to right, 90 bottom to top.", Kind::Double { default: 0.0, min: -360.0, max: 360.0, display: (-180.0, 180.0) }).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_CYCLES, "Cycles", "Sinusoid periods across the frame (sine patterns), or rings (radial; 0: the centre first, then outward).", Kind::Double { default: 2.0, min: 0.0, max: 100.0, display: (0.0, 8.0) }).in_group("transition_group"),
         ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
         ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
@@ -254,6 +279,9 @@ pub struct Settings {
     pub field: FieldSettings,
     pub mesh: MeshSettings,
     pub auto: AutoSettings,
+    pub thin_plate: ThinPlateSettings,
+    pub mffd: MffdSettings,
+    pub transition: TransitionSettings,
     pub lines: Vec<Feature>,
     pub scene_file: String,
     pub scene_text: String,
@@ -322,6 +350,50 @@ impl Settings {
             warm_start: int_or(AUTO_WARM_START, 1) != 0,
             ..AutoSettings::default()
         };
+        let tp = ThinPlateSettings::default();
+        let thin_plate = ThinPlateSettings {
+            alpha: f64_or(PLATE_ALPHA, tp.alpha).clamp(0.01, 1e6),
+            beta: f64_or(PLATE_BETA, tp.beta).clamp(0.0, 1.0),
+            ..tp
+        };
+        let mffd = MffdSettings {
+            alpha: f64_or(MFFD_ALPHA, MffdSettings::default().alpha).clamp(0.0, 1.0),
+            ..MffdSettings::default()
+        };
+        let spread = f64_or(TRANSITION_SPREAD, 0.5).clamp(0.0, 0.99);
+        let cycles = f64_or(TRANSITION_CYCLES, 2.0).clamp(0.0, 100.0);
+        let pattern = match int_or(TRANSITION, 0) {
+            1 => Some(Pattern::Ramp {
+                angle: f64_or(TRANSITION_ANGLE, 0.0),
+            }),
+            2 => Some(Pattern::SineRows { cycles }),
+            3 => Some(Pattern::SineColumns { cycles }),
+            4 => Some(Pattern::Radial {
+                cycles,
+                centre: None,
+            }),
+            _ => None,
+        };
+        let transition = match pattern {
+            None => TransitionSettings::default(),
+            Some(pattern) => {
+                let t = Transition::Procedural(Procedural { pattern, spread });
+                match int_or(TRANSITION_AFFECTS, 0) {
+                    1 => TransitionSettings {
+                        geometry: t,
+                        colour: Some(Transition::Uniform),
+                    },
+                    2 => TransitionSettings {
+                        geometry: Transition::Uniform,
+                        colour: Some(t),
+                    },
+                    _ => TransitionSettings {
+                        geometry: t,
+                        colour: None,
+                    },
+                }
+            }
+        };
         let count = int_or(LINE_COUNT, 0).clamp(0, LINE_SLOTS as i32) as usize;
         let offset_a = int_or(OFFSET_A, 0);
         let offset_b = if kind == NodeKind::Morph {
@@ -378,6 +450,9 @@ impl Settings {
             },
             mesh: MeshSettings { pass },
             auto,
+            thin_plate,
+            mffd,
+            transition,
             lines,
             scene_file,
             scene_text,

@@ -7,10 +7,12 @@ use morphfx::features::{Feature, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::resample::through;
 use morphfx::image::{ImageView, Plane, RowsMut, Sample, Sampler};
-use morphfx::morph::{dissolve, show, Warped};
+use morphfx::morph::{dissolve, dissolve_weighted, show, Warped};
 use morphfx::scene::{Method, Scene};
+use morphfx::transition::{self, Rates, Weights};
 use morphfx::views::{self, View};
 use morphfx::warp::auto::{self, Correspondence, WorkImage};
+use morphfx::warp::hybrid::HybridSettings;
 use morphfx::warp::mesh::{self, MeshPair, Pass};
 use morphfx::warp::{self, WarpMap, WarpSettings};
 use openfx::sys::generic::core::*;
@@ -196,19 +198,34 @@ fn frame_at(
     context: &str,
 ) -> Outcome<Frame> {
     let scene = load_scene(instance, settings)?;
-    let mut features = settings.lines.clone();
+    // The scene's features first, so transition curves attached by index
+    // name the scene's own features.
+    let mut features = Vec::new();
     let mut warp = WarpSettings {
         method: settings.method,
         field: settings.field,
         mesh: settings.mesh,
         auto: settings.auto.clone(),
+        thin_plate: settings.thin_plate,
+        mffd: settings.mffd,
+        hybrid: HybridSettings {
+            thin_plate: settings.thin_plate,
+            mffd: settings.mffd,
+            ..HybridSettings::default()
+        },
+        transition: settings.transition.clone(),
         ..WarpSettings::default()
     };
     let mut t = settings.progress;
     if let Some(scene) = &scene {
         features.extend(scene.features_at(time));
         if settings.settings_from_scene {
+            let node_transition = warp.transition.clone();
             warp = WarpSettings::from_scene(scene, time);
+            // A scene without a transition leaves the node's in place.
+            if warp.transition == Default::default() {
+                warp.transition = node_transition;
+            }
         } else {
             warp.meshes = scene.mesh_at(time);
         }
@@ -216,6 +233,7 @@ fn frame_at(
             t = scene.progress_at(time).unwrap_or(t);
         }
     }
+    features.extend(settings.lines.iter().cloned());
     if kind == NodeKind::Morph && context == TRANSITION {
         let transition = kOfxImageEffectTransitionParamName.to_string_lossy();
         t = effect.params()?.double(&transition, time)?.clamp(0.0, 1.0);
@@ -328,9 +346,40 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     }
     let (origin, size) = project(effect, &rod);
     let picture = matches!(settings.view, View::Morph | View::WarpedA | View::WarpedB);
-    let by_map = !(two_pass && picture);
+    let bad = |e: morphfx::Error| Failure::BadInput(e.to_string());
+    // A non-uniform colour transition weighs every pixel of the dissolve.
+    let colour = frame
+        .warp
+        .colour_rates(&frame.features, frame.t)
+        .map_err(bad)?;
+    let weighted = settings.view == View::Morph && b_img.is_some() && colour.uniform().is_none();
+    // The two-pass mesh warp makes pixels, not maps; weights need maps.
+    let by_map = !(two_pass && picture) || weighted;
+    let weights = if weighted {
+        let (ma, mb) = (map(Side::A)?, map(Side::B)?);
+        let key = key_of(&(&frame, "weights", map_window, scale.x, scale.y));
+        Some(instance.weights.get_or_compute(key, || {
+            // W1 carries B onto A: the warp of A toward B's positions.
+            let w1 = warp::toward(&frame.features, Side::A, 1.0, &frame.warp).map_err(bad)?;
+            Ok::<_, Failure>(transition::colour_weights(&colour, &ma, &mb, w1.as_ref()))
+        })?)
+    } else {
+        None
+    };
+    let rates = if settings.view == View::Transition {
+        Some(
+            frame
+                .warp
+                .geometry_rates(&frame.features, frame.t)
+                .map_err(bad)?,
+        )
+    } else {
+        None
+    };
     let job = Job {
         view: settings.view,
+        weights,
+        rates,
         t: frame.t,
         features: &frame.features,
         map_a: if needs_a(settings.view) && by_map {
@@ -456,7 +505,7 @@ fn correspondence(
 fn needs_a(view: View) -> bool {
     matches!(
         view,
-        View::Morph | View::WarpedA | View::StmapA | View::Grid
+        View::Morph | View::WarpedA | View::StmapA | View::Grid | View::Transition
     )
 }
 
@@ -487,6 +536,10 @@ fn project(effect: &Effect, rod: &OfxRectD) -> (Vec2, Vec2) {
 
 struct Job<'a> {
     view: View,
+    /// Per-pixel dissolve weights (non-uniform colour transition).
+    weights: Option<Arc<Weights>>,
+    /// Geometry rates (the transition view).
+    rates: Option<Rates>,
     t: f64,
     features: &'a [Feature],
     map_a: Option<Arc<WarpMap>>,
@@ -512,19 +565,31 @@ impl Job<'_> {
         }
         let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
         match (self.view, b) {
-            (View::Morph, Some(b)) => dissolve(
-                Warped::Map(a, ma.expect("map A")),
-                Warped::Map(b, mb.expect("map B")),
-                self.t,
-                rows,
-            ),
+            (View::Morph, Some(b)) => match &self.weights {
+                Some(w) => dissolve_weighted(
+                    Warped::Map(a, ma.expect("map A")),
+                    Warped::Map(b, mb.expect("map B")),
+                    self.t,
+                    w,
+                    rows,
+                ),
+                None => dissolve(
+                    Warped::Map(a, ma.expect("map A")),
+                    Warped::Map(b, mb.expect("map B")),
+                    self.t,
+                    rows,
+                ),
+            },
             (View::Morph | View::WarpedA, _) => through(a, ma.expect("map A"), rows),
             (View::WarpedB, Some(b)) => through(b, mb.expect("map B"), rows),
             (View::StmapA, _) => views::stmap(ma.expect("map A"), self.origin, self.size, rows),
             (View::StmapB, _) => {
                 views::stmap(mb.or(ma).expect("map"), self.origin, self.size, rows)
             }
-            (View::Transition, _) => views::transition_grey(self.t, rows),
+            (View::Transition, _) => match &self.rates {
+                Some(r) => views::transition_grey(r, ma.expect("map A"), rows),
+                None => views::transition_grey(&Rates::Uniform(self.t), ma.expect("map A"), rows),
+            },
             (View::Grid, _) => views::grid(ma.expect("map A"), self.features, self.t, rows),
             (View::WarpedB, None) => through(a, ma.expect("map A"), rows),
         }
