@@ -332,8 +332,99 @@ fn bench_auto(c: &mut Criterion) {
     g.finish();
 }
 
+/// 500 non-crossing constraints over the 1080p frame (up to 12 px moves).
+fn scattered_pairs() -> Vec<(Vec2, Vec2)> {
+    morphfx::testing::smooth_pairs(11, 500, W as f64, H as f64, 12.0, 30.0)
+}
+
+fn bench_scattered(c: &mut Criterion) {
+    use morphfx::warp::mffd::{Mffd, MffdSettings, MffdWarp};
+    use morphfx::warp::thin_plate::{ThinPlate, ThinPlateSettings, ThinPlateWarp};
+    use morphfx::warp::{hybrid, Warp};
+    let pairs = scattered_pairs();
+    assert_eq!(pairs.len(), 500);
+    let full = RectD::new(0.0, 0.0, W as f64, H as f64);
+    let mut g = c.benchmark_group("scattered_1080p_500_points");
+    g.sample_size(10);
+    g.bench_function("thin_plate_solve_and_map", |b| {
+        b.iter(|| {
+            let p = ThinPlate::solve(&pairs, full, &ThinPlateSettings::default(), None);
+            black_box(ThinPlateWarp::new(p).map_window(frame(), PixelScale::UNIT))
+        })
+    });
+    let cold = ThinPlate::solve(&pairs, full, &ThinPlateSettings::default(), None);
+    let moved: Vec<(Vec2, Vec2)> = pairs
+        .iter()
+        .map(|(p, q)| (*p, *q + Vec2::new(0.3, -0.2)))
+        .collect();
+    g.bench_function("thin_plate_warm_solve", |b| {
+        b.iter(|| {
+            black_box(ThinPlate::solve(
+                &moved,
+                full,
+                &ThinPlateSettings::default(),
+                Some(&cold),
+            ))
+        })
+    });
+    g.bench_function("mffd_solve_and_map", |b| {
+        b.iter(|| {
+            let m = Mffd::solve(&pairs, full, &MffdSettings::default());
+            black_box(MffdWarp { mffd: m }.map_window(frame(), PixelScale::UNIT))
+        })
+    });
+    g.bench_function("hybrid_solve_and_map", |b| {
+        b.iter(|| {
+            let m = hybrid::solve(&pairs, full, &hybrid::HybridSettings::default());
+            black_box(MffdWarp { mffd: m }.map_window(frame(), PixelScale::UNIT))
+        })
+    });
+    g.finish();
+}
+
+fn bench_transition(c: &mut Criterion) {
+    use morphfx::transition::{Attach, Attached, Curve, Propagation, Transition};
+    // 20 polylines across the frame, each with its own curve.
+    let features: Vec<Feature> = (0..20)
+        .map(|k| {
+            let (x, y) = (100.0 + 85.0 * k as f64, 200.0 + 30.0 * (k % 5) as f64 * 6.0);
+            let pts = vec![
+                Vec2::new(x, y),
+                Vec2::new(x + 40.0, y + 60.0),
+                Vec2::new(x + 10.0, y + 140.0),
+            ];
+            Feature::new(FeatureKind::Polyline, pts.clone(), pts).named(format!("f{k}"))
+        })
+        .collect();
+    let curves = (0..20)
+        .map(|k| Attached {
+            attach: Attach::Index(k),
+            curve: Curve::new(&[(0.5, (k as f64 / 19.0).clamp(0.05, 0.95))], "bench").unwrap(),
+        })
+        .collect();
+    let transition = Transition::Curves {
+        curves,
+        propagation: Propagation::default(),
+    };
+    let full = RectD::new(0.0, 0.0, W as f64, H as f64);
+    let mut g = c.benchmark_group("transition_1080p_20_curves");
+    g.sample_size(20);
+    g.bench_function("bspline_surface_and_dense_rates", |b| {
+        b.iter(|| {
+            let rates = transition.rates(&features, 20, full, 0.5).unwrap();
+            let morphfx::transition::Rates::Surface { delta, .. } = &rates else {
+                panic!("a surface")
+            };
+            black_box(delta.eval_window(frame(), PixelScale::UNIT))
+        })
+    });
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    bench_scattered,
+    bench_transition,
     bench_auto,
     bench_snakes,
     bench_field,
