@@ -41,6 +41,19 @@ impl<S: Sample> Warped<'_, S> {
     }
 }
 
+impl<S: Sample> Warped<'_, S> {
+    /// [`Warped::row`] in `channels` layout.
+    fn row_as(&self, j: i32, x1: i32, channels: usize, out: &mut [[f32; 4]]) {
+        self.row(j, x1, out);
+        let own = self.channels();
+        if own != channels {
+            for px in out.iter_mut() {
+                *px = adapt_channels(own, channels, *px);
+            }
+        }
+    }
+}
+
 /// One warped source written into `dst`'s layout.
 pub fn show<S: Sample, D: Sample>(src: Warped<'_, S>, dst: RowsMut<'_, D>) {
     fill_rows(dst, src.channels(), |j, x1, row, _| src.row(j, x1, row));
@@ -58,15 +71,7 @@ pub fn dissolve<S: Sample, D: Sample>(
     let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
     fill_rows(dst, dc, |j, x1, row, other| {
-        let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| {
-            src.row(j, x1, out);
-            let channels = src.channels();
-            if channels != dc {
-                for px in out.iter_mut() {
-                    *px = adapt_channels(channels, dc, *px);
-                }
-            }
-        };
+        let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| src.row_as(j, x1, dc, out);
         if wb == 0.0 {
             warped(&a, row);
         } else if wa == 0.0 {
@@ -100,15 +105,7 @@ pub fn dissolve_weighted<S: Sample, D: Sample>(
     let win = weights.window;
     let (ua, ub) = ((1.0 - t) as f32, t as f32);
     fill_rows(dst, dc, |j, x1, row, other| {
-        let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| {
-            src.row(j, x1, out);
-            let channels = src.channels();
-            if channels != dc {
-                for px in out.iter_mut() {
-                    *px = adapt_channels(channels, dc, *px);
-                }
-            }
-        };
+        let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| src.row_as(j, x1, dc, out);
         other.resize(row.len(), [0.0; 4]);
         warped(&a, row);
         warped(&b, other);

@@ -192,25 +192,4 @@ impl Plate {
         }
         v
     }
-
-    /// One Gauss-Seidel sweep over the nodes, forward or backward.
-    pub fn relax(&self, f: &mut [f64], b: &[f64], forward: bool) {
-        let n = self.nx * self.ny;
-        let mut step = |k: usize| {
-            let r = b[k] - self.apply_at(f, k);
-            f[k] += r / self.diagonal[k];
-        };
-        if forward {
-            (0..n).for_each(&mut step);
-        } else {
-            (0..n).rev().for_each(&mut step);
-        }
-    }
-
-    /// `b − A f`.
-    pub fn residual(&self, f: &[f64], b: &[f64]) -> Vec<f64> {
-        (0..self.nx * self.ny)
-            .map(|k| b[k] - self.apply_at(f, k))
-            .collect()
-    }
 }
