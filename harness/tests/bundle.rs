@@ -79,6 +79,8 @@ enum Method {
     Triangles,
     /// Found from the two sources (work minimisation).
     Auto,
+    /// The scene text's features as point pairs: thin-plate, mffd or hybrid.
+    Scattered(morphfx::scene::Method),
 }
 
 /// A 4 × 4 mesh on `bounds` (canonical at full resolution), its inner
@@ -123,7 +125,11 @@ fn scene_text(case: &Case) -> String {
                 points_json(pair.b.nodes())
             )
         }
-        Method::Triangles => {
+        Method::Triangles | Method::Scattered(_) => {
+            let name = match case.method {
+                Method::Scattered(m) => m.name(),
+                _ => "triangles",
+            };
             let f: Vec<String> = features()
                 .iter()
                 .map(|f| {
@@ -135,7 +141,8 @@ fn scene_text(case: &Case) -> String {
                 })
                 .collect();
             format!(
-                r#"{{"method": "triangles", "features": [{}]}}"#,
+                r#"{{"method": "{}", "features": [{}]}}"#,
+                name,
                 f.join(", ")
             )
         }
@@ -280,6 +287,16 @@ fn expected(case: &Case, a: &Image, b: &Image) -> Image {
         Method::Triangles => TriangleWarp::toward(&f, side, T, 20, frame)
             .unwrap()
             .map_window(full, scale),
+        Method::Scattered(m) => {
+            let settings = morphfx::warp::WarpSettings {
+                method: m,
+                frame: Some(frame),
+                ..Default::default()
+            };
+            morphfx::warp::toward(&f, side, T, &settings)
+                .unwrap()
+                .map_window(full, scale)
+        }
         _ => FieldWarp::toward(&f, side, T, &settings).map_window(full, scale),
     };
     if case.method == Method::Mesh {
@@ -515,8 +532,15 @@ fn eight_concurrent_tiles_equal_the_serial_render() {
 }
 
 #[test]
-fn mesh_triangle_and_auto_renders_match_the_core_at_every_depth_scale_and_layout() {
-    for method in [Method::Mesh, Method::Triangles, Method::Auto] {
+fn mesh_triangle_scattered_and_auto_renders_match_the_core_at_every_depth_scale_and_layout() {
+    for method in [
+        Method::Mesh,
+        Method::Triangles,
+        Method::Scattered(morphfx::scene::Method::ThinPlate),
+        Method::Scattered(morphfx::scene::Method::Mffd),
+        Method::Scattered(morphfx::scene::Method::Hybrid),
+        Method::Auto,
+    ] {
         for depth in DEPTHS {
             for scale in [1.0, 0.5] {
                 check(Case {
