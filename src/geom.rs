@@ -194,6 +194,13 @@ impl RectD {
     pub fn height(&self) -> f64 {
         self.y2 - self.y1
     }
+    /// The smallest rectangle holding this one and every point of `points`.
+    pub fn including(self, points: impl IntoIterator<Item = Vec2>) -> RectD {
+        points.into_iter().fold(self, |r, p| {
+            RectD::new(r.x1.min(p.x), r.y1.min(p.y), r.x2.max(p.x), r.y2.max(p.y))
+        })
+    }
+
     pub fn is_valid(&self) -> bool {
         [self.x1, self.y1, self.x2, self.y2]
             .iter()

@@ -7,12 +7,12 @@ use std::path::Path;
 mod common;
 
 use morphfx::features::Side;
-use morphfx::geom::{RectD, RectI, Vec2};
+use morphfx::geom::{RectD, Vec2};
 use morphfx::image::Image;
 use morphfx::testing::texture;
 use morphfx::warp::auto::{self, AutoSettings, WorkImage};
 use morphfx::warp::Warp;
-use morphfx_harness::io::{self, ExrPrecision, Plate};
+use morphfx_harness::io;
 
 const W: usize = 160;
 const H: usize = 120;
@@ -25,19 +25,7 @@ fn h(p: Vec2) -> Vec2 {
 }
 
 fn plate(path: &Path, warp: impl Fn(Vec2) -> Vec2) -> Image {
-    let img = Image::from_fn(RectI::from_size(W, H), 4, |i, j, c| {
-        if c == 3 {
-            1.0
-        } else {
-            texture(warp(Vec2::new(i as f64 + 0.5, j as f64 + 0.5)))[c]
-        }
-    });
-    let plate = Plate {
-        image: img.clone(),
-        size: (W, H),
-    };
-    io::write(path, &plate, ExrPrecision::Float).unwrap();
-    img
+    common::colour_plate(path, W, H, |p| texture(warp(p)))
 }
 
 fn s(p: &Path) -> &str {

@@ -11,25 +11,13 @@ use morphfx::image::Image;
 use morphfx::scene::Scene;
 use morphfx::testing::texture;
 use morphfx::warp::{self, WarpSettings};
-use morphfx_harness::io::{self, ExrPrecision, Plate};
+use morphfx_harness::io;
 
 const W: usize = 128;
 const H: usize = 96;
 
 fn plate(path: &Path, colour: impl Fn(Vec2) -> [f32; 3]) -> Image {
-    let img = Image::from_fn(RectI::from_size(W, H), 4, |i, j, c| {
-        if c == 3 {
-            1.0
-        } else {
-            colour(Vec2::new(i as f64 + 0.5, j as f64 + 0.5))[c]
-        }
-    });
-    let plate = Plate {
-        image: img.clone(),
-        size: (W, H),
-    };
-    io::write(path, &plate, ExrPrecision::Float).unwrap();
-    img
+    common::colour_plate(path, W, H, colour)
 }
 
 fn s(p: &Path) -> &str {

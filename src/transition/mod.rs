@@ -140,6 +140,18 @@ impl Rates {
 }
 
 impl Transition {
+    /// Whether every point is at rate `t` at progress `t`, known without
+    /// computing any rate: uniform, the end frames, or a pattern of no spread.
+    pub fn is_uniform_at(&self, t: f64) -> bool {
+        t <= 0.0
+            || t >= 1.0
+            || match self {
+                Transition::Uniform => true,
+                Transition::Procedural(p) => p.spread == 0.0,
+                Transition::Curves { .. } => false,
+            }
+    }
+
     /// The rates at progress `t` for the features of this frame (curves
     /// attached to features follow them; polylines and curves sampled
     /// `per_segment` times per span) over `frame` (canonical, A).
@@ -150,19 +162,15 @@ impl Transition {
         frame: RectD,
         t: f64,
     ) -> Result<Rates> {
-        if t <= 0.0 || t >= 1.0 {
+        if self.is_uniform_at(t) {
             return Ok(Rates::Uniform(t.clamp(0.0, 1.0)));
         }
         match self {
             Transition::Uniform => Ok(Rates::Uniform(t)),
-            Transition::Procedural(procedural) => Ok(if procedural.spread == 0.0 {
-                Rates::Uniform(t)
-            } else {
-                Rates::Procedural {
-                    procedural: *procedural,
-                    frame,
-                    t,
-                }
+            Transition::Procedural(procedural) => Ok(Rates::Procedural {
+                procedural: *procedural,
+                frame,
+                t,
             }),
             Transition::Curves {
                 curves,
@@ -172,12 +180,8 @@ impl Transition {
                 if points.iter().all(|(_, d)| *d == 0.0) {
                     return Ok(Rates::Uniform(t));
                 }
-                let (mut min, mut max) =
-                    (Vec2::new(frame.x1, frame.y1), Vec2::new(frame.x2, frame.y2));
-                for (p, _) in &points {
-                    min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
-                    max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
-                }
+                let area = frame.including(points.iter().map(|(p, _)| *p));
+                let (min, max) = (Vec2::new(area.x1, area.y1), Vec2::new(area.x2, area.y2));
                 Ok(match propagation {
                     Propagation::BSpline(s) => Rates::Surface {
                         t,
@@ -188,7 +192,6 @@ impl Transition {
                             .iter()
                             .map(|(p, d)| (*p, *p + Vec2::new(*d, 0.0)))
                             .collect();
-                        let area = RectD::new(min.x, min.y, max.x, max.y);
                         Rates::Plate {
                             t,
                             delta: ThinPlate::solve(&pairs, area, s, None).nodes,

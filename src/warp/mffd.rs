@@ -224,12 +224,8 @@ impl Mffd {
 /// One FFD manipulation (seed 000 §5.3's algorithm) on a lattice of spacing `h`
 /// that covers the frame and every point.
 fn ffd_step(at: &[Vec2], targets: &[Vec2], frame: RectD, h: f64, truncate: bool) -> Deformation {
-    let (mut min, mut max) = (Vec2::new(frame.x1, frame.y1), Vec2::new(frame.x2, frame.y2));
-    for p in at.iter().chain(targets) {
-        min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
-        max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
-    }
-    let lattice = Lattice::covering(min, max, h);
+    let area = frame.including(at.iter().chain(targets).copied());
+    let lattice = Lattice::covering(Vec2::new(area.x1, area.y1), Vec2::new(area.x2, area.y2), h);
     let mut fit = Approximation::new(&lattice);
     for (p, q) in at.iter().zip(targets) {
         fit.add(*p, *q - *p);

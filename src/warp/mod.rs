@@ -263,8 +263,8 @@ impl WarpSettings {
         features: &[Feature],
         t: f64,
     ) -> Result<Rates> {
-        if *transition == crate::transition::Transition::Uniform {
-            return Ok(Rates::Uniform(t));
+        if transition.is_uniform_at(t) {
+            return Ok(Rates::Uniform(t.clamp(0.0, 1.0)));
         }
         let frame = self
             .frame
@@ -300,14 +300,12 @@ pub fn point_pairs_toward(
 /// The bounds of every feature point on both sides, grown by half their size
 /// on each side (at least 16 px).
 fn feature_bounds(features: &[Feature]) -> Option<RectD> {
-    let pts = features.iter().flat_map(|f| f.a.iter().chain(&f.b));
-    let mut r: Option<RectD> = None;
-    for p in pts {
-        let b = r.get_or_insert(RectD::new(p.x, p.y, p.x, p.y));
-        *b = RectD::new(b.x1.min(p.x), b.y1.min(p.y), b.x2.max(p.x), b.y2.max(p.y));
-    }
-    r.map(|b| {
-        let (mx, my) = ((b.width() * 0.5).max(16.0), (b.height() * 0.5).max(16.0));
-        RectD::new(b.x1 - mx, b.y1 - my, b.x2 + mx, b.y2 + my)
-    })
+    let mut pts = features
+        .iter()
+        .flat_map(|f| f.a.iter().chain(&f.b))
+        .copied();
+    let first = pts.next()?;
+    let b = RectD::new(first.x, first.y, first.x, first.y).including(pts);
+    let (mx, my) = ((b.width() * 0.5).max(16.0), (b.height() * 0.5).max(16.0));
+    Some(RectD::new(b.x1 - mx, b.y1 - my, b.x2 + mx, b.y2 + my))
 }

@@ -47,3 +47,29 @@ pub fn step_plate(bounds: morphfx::geom::RectI, edge: f64) -> morphfx::image::Im
         }
     })
 }
+
+/// An opaque `w × h` float EXR at `path` whose pixel centres take `colour`
+/// (canonical position in, RGB out); returns the image written.
+#[allow(dead_code)] // not every test file writes generated plates
+pub fn colour_plate(
+    path: &Path,
+    w: usize,
+    h: usize,
+    colour: impl Fn(morphfx::geom::Vec2) -> [f32; 3],
+) -> morphfx::image::Image {
+    use morphfx_harness::io::{self, ExrPrecision, Plate};
+    let image =
+        morphfx::image::Image::from_fn(morphfx::geom::RectI::from_size(w, h), 4, |i, j, c| {
+            if c == 3 {
+                1.0
+            } else {
+                colour(morphfx::geom::Vec2::new(i as f64 + 0.5, j as f64 + 0.5))[c]
+            }
+        });
+    let plate = Plate {
+        image: image.clone(),
+        size: (w, h),
+    };
+    io::write(path, &plate, ExrPrecision::Float).unwrap();
+    image
+}

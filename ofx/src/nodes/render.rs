@@ -348,17 +348,19 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     let picture = matches!(settings.view, View::Morph | View::WarpedA | View::WarpedB);
     let bad = |e: morphfx::Error| Failure::BadInput(e.to_string());
     // A non-uniform colour transition weighs every pixel of the dissolve.
-    let colour = frame
-        .warp
-        .colour_rates(&frame.features, frame.t)
-        .map_err(bad)?;
-    let weighted = settings.view == View::Morph && b_img.is_some() && colour.uniform().is_none();
+    let weighted = settings.view == View::Morph
+        && b_img.is_some()
+        && !frame.warp.transition.colour().is_uniform_at(frame.t);
     // The two-pass mesh warp makes pixels, not maps; weights need maps.
     let by_map = !(two_pass && picture) || weighted;
     let weights = if weighted {
         let (ma, mb) = (map(Side::A)?, map(Side::B)?);
         let key = key_of(&(&frame, "weights", map_window, scale.x, scale.y));
         Some(instance.weights.get_or_compute(key, || {
+            let colour = frame
+                .warp
+                .colour_rates(&frame.features, frame.t)
+                .map_err(bad)?;
             // W1 carries B onto A: the warp of A toward B's positions.
             let w1 = warp::toward(&frame.features, Side::A, 1.0, &frame.warp).map_err(bad)?;
             Ok::<_, Failure>(transition::colour_weights(&colour, &ma, &mb, w1.as_ref()))

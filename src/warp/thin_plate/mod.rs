@@ -78,11 +78,8 @@ impl ThinPlate {
             }
         };
         let rhs = |pick: fn(Vec2) -> f64| {
-            let mut plate = hierarchy.plate.clone();
-            for (spring, (p, q)) in plate.springs.iter_mut().zip(pairs) {
-                spring.z = pick(*q - *p);
-            }
-            plate.rhs()
+            let z: Vec<f64> = pairs.iter().map(|(p, q)| pick(*q - *p)).collect();
+            hierarchy.plate.rhs_for(&z)
         };
         let solve = |pick: fn(Vec2) -> f64| {
             let mut f = start(pick);
@@ -106,11 +103,8 @@ impl ThinPlate {
 /// nodes are every other node of the finer one, down to a grid of at most
 /// about 8 cells along its longer side for the direct solve.
 fn layout(frame: RectD, pairs: &[(Vec2, Vec2)], cell: f64) -> (Vec2, usize, usize, usize) {
-    let (mut min, mut max) = (Vec2::new(frame.x1, frame.y1), Vec2::new(frame.x2, frame.y2));
-    for (p, _) in pairs {
-        min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
-        max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
-    }
+    let area = frame.including(pairs.iter().map(|(p, _)| *p));
+    let (min, max) = (Vec2::new(area.x1, area.y1), Vec2::new(area.x2, area.y2));
     let cx = ((max.x - min.x) / cell).ceil().max(1.0) as usize;
     let cy = ((max.y - min.y) / cell).ceil().max(1.0) as usize;
     let (short, long) = (cx.min(cy), cx.max(cy));

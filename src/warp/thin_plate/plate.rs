@@ -35,8 +35,6 @@ pub struct Plate {
     /// For each node, the springs pulling it (CSR: `spring_start[n]..[n+1]`).
     spring_start: Vec<usize>,
     spring_index: Vec<(u32, u8)>,
-    /// The diagonal of `A`.
-    pub diagonal: Vec<f64>,
 }
 
 impl Plate {
@@ -82,7 +80,7 @@ impl Plate {
                 fill[n] += 1;
             }
         }
-        let mut plate = Plate {
+        Plate {
             nx,
             ny,
             h,
@@ -91,17 +89,15 @@ impl Plate {
             springs,
             spring_start: count,
             spring_index,
-            diagonal: Vec::new(),
-        };
-        plate.diagonal = (0..nx * ny).map(|n| plate.diagonal_at(n)).collect();
-        plate
+        }
     }
 
     fn bend(&self) -> f64 {
         1.0 / (self.h * self.h)
     }
 
-    fn diagonal_at(&self, n: usize) -> f64 {
+    /// `A[n][n]`, from the count of stencil positions that touch the node.
+    pub fn diagonal_at(&self, n: usize) -> f64 {
         let (i, j) = (n % self.nx, n / self.nx);
         let second = |i: usize, n: usize| -> f64 {
             // Stencil positions i−1, i, i+1 (coefficients 1, −2, 1) that fit.
@@ -125,12 +121,18 @@ impl Plate {
         d
     }
 
-    /// `b`: the springs' pull, `α Σ w z`.
+    /// `b`: the springs' pull, `α Σ w z`, with the springs' own heights.
     pub fn rhs(&self) -> Vec<f64> {
+        let z: Vec<f64> = self.springs.iter().map(|s| s.z).collect();
+        self.rhs_for(&z)
+    }
+
+    /// `b` for heights `z` (one per spring): one plate serves both surfaces.
+    pub fn rhs_for(&self, z: &[f64]) -> Vec<f64> {
         let mut b = vec![0.0; self.nx * self.ny];
-        for s in &self.springs {
+        for (s, z) in self.springs.iter().zip(z) {
             for c in 0..4 {
-                b[s.nodes[c]] += self.alpha * s.weights[c] * s.z;
+                b[s.nodes[c]] += self.alpha * s.weights[c] * z;
             }
         }
         b
