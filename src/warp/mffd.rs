@@ -11,8 +11,9 @@
 
 use super::node_grid::NodeGrid;
 use super::{Warp, WarpMap};
-use crate::bspline::{Approximation, Lattice};
+use crate::bspline::{basis, Approximation, Lattice};
 use crate::geom::{PixelScale, RectD, RectI, Vec2};
+use wide::f64x4;
 
 /// Theorem 1's bound on a control displacement, in lattice spacings.
 pub const ONE_TO_ONE_BOUND: f64 = 0.48;
@@ -58,61 +59,105 @@ const MAX_STEPS: usize = 96;
 pub struct Deformation {
     pub dx: Lattice,
     pub dy: Lattice,
-    /// Cells whose 16 controls are not all zero (cell `c` at index `c + 2`),
-    /// so evaluation skips the rest of the plane; `None` when `dx` and `dy`
-    /// differ in geometry (then every point is evaluated).
-    active: Option<Vec<bool>>,
+    /// The layout [`Deformation::apply`] reads; `None` when `dx` and `dy`
+    /// differ in geometry (then both lattices are evaluated separately).
+    packed: Option<Packed>,
 }
 
-impl Deformation {
-    pub fn new(dx: Lattice, dy: Lattice) -> Self {
-        if (dx.origin, dx.h, dx.nx, dx.ny) != (dy.origin, dy.h, dy.nx, dy.ny) {
-            return Deformation {
-                dx,
-                dy,
-                active: None,
-            };
-        }
+/// Both lattices' controls interleaved and padded with `PAD` zeros on every
+/// side, so a point in any cell a control reaches reads its 16 `(dx, dy)`
+/// pairs without bounds checks and with one set of basis weights. Cells whose
+/// 16 controls are all zero are marked, so the rest of the plane costs one
+/// lookup: a fine lattice's step touches only the pixels near its features.
+#[derive(Debug, Clone, PartialEq)]
+struct Packed {
+    controls: Vec<f64>,
+    /// Controls per row of `controls` (two values each): `nx + 2 PAD`.
+    stride: usize,
+    /// Per cell `c ∈ −2..=nx` (stored at `c + 2`): whether any control it
+    /// reads is non-zero. Row length `nx + 3` (`stride − PAD`).
+    active: Vec<bool>,
+    /// Stored cells per row and column (`nx + 3`, `ny + 3`).
+    cells: (f64, f64),
+    origin: Vec2,
+    inverse_h: f64,
+}
+
+/// Zeros around the stored controls: cell `−2` reads control `−3`.
+const PAD: usize = 3;
+
+impl Packed {
+    fn new(dx: &Lattice, dy: &Lattice) -> Packed {
         let (nx, ny) = (dx.nx, dx.ny);
+        let stride = nx + 2 * PAD;
+        let mut controls = vec![0.0; 2 * stride * (ny + 2 * PAD)];
         let (cx, cy) = (nx + 3, ny + 3);
         let mut active = vec![false; cx * cy];
         for j in 0..ny {
             for i in 0..nx {
                 let k = j * nx + i;
+                let at = 2 * ((j + PAD) * stride + i + PAD);
+                controls[at] = dx.phi[k];
+                controls[at + 1] = dy.phi[k];
                 if dx.phi[k] != 0.0 || dy.phi[k] != 0.0 {
                     // Control i is read by cells i−2 ..= i+1, stored at +2.
-                    for r in j..j + 4 {
-                        for c in i..i + 4 {
-                            active[r * cx + c] = true;
-                        }
+                    for row in active[j * cx..(j + 4) * cx].chunks_mut(cx) {
+                        row[i..i + 4].fill(true);
                     }
                 }
             }
         }
-        Deformation {
-            dx,
-            dy,
-            active: Some(active),
+        Packed {
+            controls,
+            stride,
+            active,
+            cells: (cx as f64, cy as f64),
+            origin: dx.origin,
+            inverse_h: 1.0 / dx.h,
         }
     }
+}
 
-    #[inline]
-    fn is_active(&self, p: Vec2) -> bool {
-        let Some(active) = &self.active else {
-            return true;
-        };
-        let (c, r, _, _) = self.dx.locate(p);
-        let (cx, cy) = (self.dx.nx as i64 + 3, self.dx.ny as i64 + 3);
-        let (c, r) = (c + 2, r + 2);
-        c >= 0 && r >= 0 && c < cx && r < cy && active[(r * cx + c) as usize]
+impl Deformation {
+    pub fn new(dx: Lattice, dy: Lattice) -> Self {
+        let same = (dx.origin, dx.h, dx.nx, dx.ny) == (dy.origin, dy.h, dy.nx, dy.ny);
+        let packed = same.then(|| Packed::new(&dx, &dy));
+        Deformation { dx, dy, packed }
     }
 
     #[inline]
     pub fn apply(&self, p: Vec2) -> Vec2 {
-        if !self.is_active(p) {
+        let Some(packed) = &self.packed else {
+            return p + Vec2::new(self.dx.eval(p), self.dy.eval(p));
+        };
+        // Lattice coordinates shifted by 2, so the stored cell is the integer
+        // part (cells −2 ..= nx are stored; beyond them the step is identity).
+        let u = (p.x - packed.origin.x) * packed.inverse_h + 2.0;
+        let v = (p.y - packed.origin.y) * packed.inverse_h + 2.0;
+        if !(u >= 0.0 && v >= 0.0 && u < packed.cells.0 && v < packed.cells.1) {
             return p;
         }
-        p + Vec2::new(self.dx.eval(p), self.dy.eval(p))
+        let (c, r) = (u as usize, v as usize);
+        let (s, t) = (u - c as f64, v - r as f64);
+        if !packed.active[r * (packed.stride - PAD) + c] {
+            return p;
+        }
+        // Cell c reads controls c−1 ..= c+2, stored from c on (PAD = 3).
+        // A row of 4 (dx, dy) pairs is two 4-lane vectors: the rows are mixed
+        // by the y weights, then the columns by the x weights.
+        let (bs, bt) = (basis(s), basis(t));
+        let (mut lo, mut hi) = (f64x4::ZERO, f64x4::ZERO);
+        for (l, &wt) in bt.iter().enumerate() {
+            let start = 2 * ((r + l) * packed.stride + c);
+            let row: &[f64; 8] = packed.controls[start..start + 8].try_into().unwrap();
+            let wt = f64x4::splat(wt);
+            lo = f64x4::from([row[0], row[1], row[2], row[3]]).mul_add(wt, lo);
+            hi = f64x4::from([row[4], row[5], row[6], row[7]]).mul_add(wt, hi);
+        }
+        let sum = (lo * f64x4::from([bs[0], bs[0], bs[1], bs[1]])
+            + hi * f64x4::from([bs[2], bs[2], bs[3], bs[3]]))
+        .to_array();
+        p + Vec2::new(sum[0] + sum[2], sum[1] + sum[3])
     }
 
     /// The Jacobian `[[∂x/∂u, ∂x/∂v], [∂y/∂u, ∂y/∂v]]` at `p`.
@@ -208,6 +253,17 @@ impl Mffd {
         self.steps.iter().fold(p, |p, d| d.apply(p))
     }
 
+    /// The composed warp at every point of `points`, in place: step by step
+    /// over all of them, so the evaluations of one step are independent and
+    /// overlap in the CPU, and each step's controls stay in cache.
+    pub fn apply_all(&self, points: &mut [Vec2]) {
+        for d in &self.steps {
+            for p in points.iter_mut() {
+                *p = d.apply(*p);
+            }
+        }
+    }
+
     /// The Jacobian determinant of the composition at `p` (chain rule).
     pub fn jacobian_det(&self, p: Vec2) -> f64 {
         let mut det = 1.0;
@@ -259,7 +315,7 @@ impl Warp for MffdWarp {
         let hi = scale.pixel_centre(window.x2 - 1, window.y2 - 1);
         let unit = scale.pixel_centre(1, 1) - scale.pixel_centre(0, 0);
         let mut nodes = NodeGrid::covering(lo, hi, unit * self.mffd.grid.max(1.0));
-        nodes.fill(|p| self.mffd.apply(p));
+        nodes.fill_rows(|row| self.mffd.apply_all(row));
         nodes.map_window(window, scale)
     }
 }

@@ -41,16 +41,24 @@ impl NodeGrid {
         )
     }
 
-    /// Fills every node's displacement with `f(node position)`, rows in parallel.
-    pub fn fill(&mut self, f: impl Fn(Vec2) -> Vec2 + Sync) {
+    /// Fills every node's displacement from `f`, which maps a row of node
+    /// positions in place (a row at a time, so a map made of stages can run
+    /// each stage over the whole row); rows in parallel.
+    pub fn fill_rows(&mut self, f: impl Fn(&mut [Vec2]) + Sync) {
         let (nx, origin, step) = (self.nx, self.origin, self.step);
         self.disp
             .par_chunks_mut(nx)
             .enumerate()
             .for_each(|(j, row)| {
+                let node = |i: usize| {
+                    Vec2::new(origin.x + i as f64 * step.x, origin.y + j as f64 * step.y)
+                };
                 for (i, d) in row.iter_mut().enumerate() {
-                    let p = Vec2::new(origin.x + i as f64 * step.x, origin.y + j as f64 * step.y);
-                    *d = f(p) - p;
+                    *d = node(i);
+                }
+                f(row);
+                for (i, d) in row.iter_mut().enumerate() {
+                    *d = *d - node(i);
                 }
             });
     }

@@ -73,6 +73,45 @@ fn mffd_dense_map_stays_close_to_the_exact_composition() {
     assert!(worst < 0.05, "dense map off by {worst} px");
 }
 
+#[test]
+fn a_deformation_is_its_two_lattices_everywhere() {
+    // The packed evaluation (both lattices interleaved, zero cells skipped)
+    // against the lattices' own, on the lattice, at its edges and far away.
+    let mut r = Lcg::new(21);
+    let lattice = |r: &mut Lcg| {
+        let mut l = Lattice::zero(Vec2::new(-7.0, 3.0), 5.0, 9, 6);
+        for v in l.phi.iter_mut() {
+            // Sparse, as a fine step's controls are.
+            *v = if r.unit() < 0.3 {
+                r.range(-2.0, 2.0)
+            } else {
+                0.0
+            };
+        }
+        l
+    };
+    let (dx, dy) = (lattice(&mut r), lattice(&mut r));
+    let d = Deformation::new(dx.clone(), dy.clone());
+    let points: Vec<Vec2> = (0..4000)
+        .map(|_| Vec2::new(r.range(-40.0, 70.0), r.range(-30.0, 60.0)))
+        .collect();
+    for p in &points {
+        let exact = *p + Vec2::new(dx.eval(*p), dy.eval(*p));
+        assert!(d.apply(*p).distance(exact) < 1e-12, "{p:?}");
+    }
+    // A composition over a batch equals it point by point.
+    let mffd = Mffd::solve(
+        &smooth_pairs(2, 30, 256.0, 192.0, 10.0, 16.0),
+        FRAME,
+        &MffdSettings::default(),
+    );
+    let mut batch = points.clone();
+    mffd.apply_all(&mut batch);
+    for (p, q) in points.iter().zip(&batch) {
+        assert_eq!(mffd.apply(*p), *q);
+    }
+}
+
 /// Constraints that ask for folds: pairs that swap places, and a row of
 /// points that must cross another row.
 fn adversarial(seed: u64) -> Vec<(Vec2, Vec2)> {
