@@ -3,7 +3,7 @@
 
 use super::hybrid::{self, HybridSettings};
 use super::mffd::{Deformation, Mffd, MffdSettings, MffdWarp};
-use super::thin_plate::multigrid::Hierarchy;
+use super::thin_plate::multigrid::{Hierarchy, Stencil};
 use super::thin_plate::plate::Plate;
 use super::thin_plate::{ThinPlate, ThinPlateSettings, ThinPlateWarp};
 use super::Warp;
@@ -419,6 +419,44 @@ fn multigrid_matches_a_direct_solve_and_converges_per_cycle() {
     for (m, d) in f.iter().zip(&direct) {
         assert!((m - d).abs() < 1e-6 * scale, "{m} vs {d}");
     }
+}
+
+#[test]
+fn a_sweep_is_gauss_seidel_node_by_node() {
+    // The sweeps carry fresh values in registers and share stencils; they
+    // must still be plain Gauss-Seidel, on the plate and on a Galerkin level.
+    let plate = small_plate(5, 23, 19);
+    let fine = Stencil::of(&plate);
+    assert!(fine.distinct() < 23 * 19, "interior stencils are shared");
+    for stencil in [fine.clone(), fine.galerkin()] {
+        let n = stencil.nx * stencil.ny;
+        let mut r = Lcg::new(9);
+        let b: Vec<f64> = (0..n).map(|_| r.range(-1.0, 1.0)).collect();
+        let start: Vec<f64> = (0..n).map(|_| r.range(-1.0, 1.0)).collect();
+        for forward in [true, false] {
+            let mut reference = start.clone();
+            let order: Vec<usize> = if forward {
+                (0..n).collect()
+            } else {
+                (0..n).rev().collect()
+            };
+            for k in order {
+                let d = stencil.apply_at(&unit(n, k), k);
+                reference[k] += (b[k] - stencil.apply_at(&reference, k)) / d;
+            }
+            let mut swept = start.clone();
+            stencil.relax(&mut swept, &b, forward);
+            for (s, e) in swept.iter().zip(&reference) {
+                assert!((s - e).abs() < 1e-12 * e.abs().max(1.0), "{s} vs {e}");
+            }
+        }
+    }
+}
+
+fn unit(n: usize, k: usize) -> Vec<f64> {
+    let mut u = vec![0.0; n];
+    u[k] = 1.0;
+    u
 }
 
 #[test]
