@@ -240,6 +240,37 @@ fn thin_plate_meets_non_crossing_constraints() {
 }
 
 #[test]
+fn thin_plate_stops_within_its_tolerance_of_the_solution() {
+    // The free edges between the springs and the frame are the slowest
+    // part to settle, and leave almost no residual while they are off.
+    let pairs = smooth_pairs(6, 40, 256.0, 192.0, 12.0, 16.0);
+    let converged = ThinPlateSettings {
+        tolerance: 1e-7,
+        max_cycles: 400,
+        ..ThinPlateSettings::default()
+    };
+    let exact = ThinPlate::solve(&pairs, FRAME, &converged, None);
+    assert!(*exact.report_x.moved.last().unwrap() <= 1e-7);
+    for tolerance in [0.1, 0.01, 0.001] {
+        let s = ThinPlateSettings {
+            tolerance,
+            ..ThinPlateSettings::default()
+        };
+        let plate = ThinPlate::solve(&pairs, FRAME, &s, None);
+        let off = plate
+            .nodes
+            .disp
+            .iter()
+            .zip(&exact.nodes.disp)
+            .fold(0.0f64, |m, (a, b)| m.max(a.distance(*b)));
+        assert!(
+            off <= 3.0 * tolerance,
+            "tolerance {tolerance}: {off} px off"
+        );
+    }
+}
+
+#[test]
 fn thin_plate_glue_localises_the_pull() {
     // One constraint: without glue the whole plate translates; with glue
     // the pull dies away within a few multiples of β^(−1/4).
@@ -260,7 +291,9 @@ fn thin_plate_glue_localises_the_pull() {
         None,
     ));
     let far = Vec2::new(20.0, 20.0);
-    assert!((free.map(far) - far).x > 9.9, "{:?}", free.map(far));
+    // One spring leaves the plate's tilts about it free (zero energy), so the
+    // free plate's far displacement is 10 px up to a slight tilt.
+    assert!((free.map(far) - far).x > 9.5, "{:?}", free.map(far));
     assert!(
         (glued.map(far) - far).length() < 0.5,
         "{:?}",

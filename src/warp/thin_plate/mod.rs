@@ -21,7 +21,7 @@ pub struct ThinPlateSettings {
     pub beta: f64,
     /// Node spacing (canonical px).
     pub cell: f64,
-    /// Stop when `‖b − A f‖ ≤ tolerance · ‖b‖`.
+    /// Stop when an iteration moves no node by more than this (px).
     pub tolerance: f64,
     pub max_cycles: usize,
 }
@@ -32,8 +32,8 @@ impl Default for ThinPlateSettings {
             alpha: 100.0,
             beta: 0.0,
             cell: 4.0,
-            tolerance: 1e-4,
-            max_cycles: 40,
+            tolerance: 0.01,
+            max_cycles: 60,
         }
     }
 }
