@@ -166,3 +166,94 @@ fn transitions_keep_the_end_frames_exact() {
     let g = grey.pixel(mid.x as i32, mid.y as i32)[0] as f64;
     assert!((g - 0.9).abs() < 0.02, "{g}");
 }
+
+/// `thin-plate: frame F side S: warm start, X + Y cycles` lines of `--verbose`.
+fn plate_solves(err: &str) -> Vec<(i32, String, bool, usize)> {
+    err.lines()
+        .filter_map(|l| {
+            let rest = l.strip_prefix("thin-plate: frame ")?;
+            let (frame, rest) = rest.split_once(" side ")?;
+            let (side, rest) = rest.split_once(": ")?;
+            let (start, rest) = rest.split_once(" start, ")?;
+            let (x, rest) = rest.split_once(" + ")?;
+            let y = rest.strip_suffix(" cycles")?;
+            Some((
+                frame.parse().ok()?,
+                side.to_string(),
+                start == "warm",
+                x.parse::<usize>().ok()? + y.parse::<usize>().ok()?,
+            ))
+        })
+        .collect()
+}
+
+#[test]
+fn thin_plates_start_from_the_previous_frame() {
+    let d = common::scratch("scattered-warm");
+    for f in 1..=3 {
+        plate(&d.join(format!("a.{f:04}.exr")), texture);
+        plate(&d.join(format!("b.{f:04}.exr")), texture);
+    }
+    // Every point moves about a pixel a frame.
+    let keyed = |dx: f64| FEATURES.replace("[[30.5, 40.5]]", &format!("[[{}, 40.5]]", 30.5 + dx));
+    let scene = format!(
+        r#"{{"method": "thin-plate", "thin-plate": {{"tolerance": 0.001}}, {},
+        "keyframes": [{{"frame": 1, {}}}, {{"frame": 3, {}}}]}}"#,
+        FEATURES,
+        keyed(0.0).trim_start_matches(|c| c != '"'),
+        keyed(2.0).trim_start_matches(|c| c != '"'),
+    );
+    std::fs::write(d.join("s.json"), &scene).unwrap();
+    let render = |frames: &str, tag: &str| {
+        let out = common::run_morphfx(&[
+            "--verbose",
+            "morph",
+            "--scene",
+            s(&d.join("s.json")),
+            "--a",
+            s(&d.join("a.####.exr")),
+            "--b",
+            s(&d.join("b.####.exr")),
+            "--frames",
+            frames,
+            "--t",
+            "0.5",
+            "-o",
+            s(&d.join(format!("{tag}.####.exr"))),
+            "--stmap-a",
+            s(&d.join(format!("{tag}-st.####.exr"))),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    let err = render("1-3", "seq");
+    let solves: Vec<_> = plate_solves(&err)
+        .into_iter()
+        .filter(|s| s.1 == "A")
+        .collect();
+    assert_eq!(solves.len(), 3, "{err}");
+    assert!(!solves[0].2 && solves[1].2 && solves[2].2, "{err}");
+    for later in &solves[1..] {
+        assert!(
+            later.3 < solves[0].3,
+            "warm {} vs cold {}: {err}",
+            later.3,
+            solves[0].3
+        );
+    }
+    // Started warm or cold, frame 2's plates are the same solution.
+    let err = render("2", "alone");
+    assert!(plate_solves(&err).iter().all(|s| !s.2), "{err}");
+    let warm = io::read(&d.join("seq-st.0002.exr")).unwrap().image;
+    let cold = io::read(&d.join("alone-st.0002.exr")).unwrap().image;
+    for j in 0..H as i32 {
+        for i in 0..W as i32 {
+            for c in 0..2 {
+                let (w, k) = (warm.pixel(i, j)[c], cold.pixel(i, j)[c]);
+                // ST is normalised: 0.01 px of a 128 px wide plate.
+                assert!((w - k).abs() < 0.01 / W as f32, "({i}, {j}) {w} vs {k}");
+            }
+        }
+    }
+}

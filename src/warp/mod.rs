@@ -185,63 +185,115 @@ pub fn toward(
     t: f64,
     settings: &WarpSettings,
 ) -> Result<Arc<dyn Warp>> {
+    with_tween(features, t, settings, |tween| {
+        let pairs = || point_pairs_toward(features, side, tween, settings.samples_per_segment);
+        match settings.method {
+            Method::Field => Ok(
+                Arc::new(FieldWarp::toward(features, side, tween, &settings.field))
+                    as Arc<dyn Warp>,
+            ),
+            Method::Mesh => Ok(Arc::new(MeshWarp::toward(
+                settings.mesh_pair()?,
+                side,
+                tween,
+            ))),
+            Method::Triangles => Ok(Arc::new(TriangleWarp::toward(
+                features,
+                side,
+                tween,
+                settings.samples_per_segment,
+                settings.scattered_frame(features)?,
+            )?)),
+            Method::ThinPlate => Ok(Arc::new(thin_plate_with(
+                features, side, tween, settings, None,
+            )?)),
+            Method::Mffd => Ok(Arc::new(MffdWarp {
+                mffd: Mffd::solve(
+                    &pairs(),
+                    settings.scattered_frame(features)?,
+                    &settings.mffd,
+                ),
+            })),
+            Method::Hybrid => Ok(Arc::new(MffdWarp {
+                mffd: hybrid::solve(
+                    &pairs(),
+                    settings.scattered_frame(features)?,
+                    &settings.hybrid,
+                ),
+            })),
+            Method::Auto => {
+                let c = settings.correspondence.as_ref().ok_or_else(|| {
+                    Error::Invalid(
+                        "method \"auto\" needs both images: its correspondence is solved from A and B (the Morph node, morphfx morph)".into(),
+                    )
+                })?;
+                Ok(Arc::new(c.toward(side, tween)))
+            }
+        }
+    })
+}
+
+/// The `thin-plate` warp as [`toward`] makes it, its plates solved from
+/// `warm` (the same side's plates at a sequence's previous frame; a plate on
+/// another grid is ignored): a host rendering frame after frame keeps each
+/// frame's plates to start the next from.
+pub fn thin_plate_toward(
+    features: &[Feature],
+    side: Side,
+    t: f64,
+    settings: &WarpSettings,
+    warm: Option<&ThinPlate>,
+) -> Result<ThinPlateWarp> {
+    with_tween(features, t, settings, |tween| {
+        thin_plate_with(features, side, tween, settings, warm)
+    })
+}
+
+fn thin_plate_with(
+    features: &[Feature],
+    side: Side,
+    tween: Tween<'_>,
+    settings: &WarpSettings,
+    warm: Option<&ThinPlate>,
+) -> Result<ThinPlateWarp> {
+    let pairs = point_pairs_toward(features, side, tween, settings.samples_per_segment);
+    let frame = settings.scattered_frame(features)?;
+    Ok(ThinPlateWarp::new(ThinPlate::solve(
+        &pairs,
+        frame,
+        &settings.thin_plate,
+        warm,
+    )))
+}
+
+/// `f` with the in-between positions at `t`: one `t` for every point, or
+/// each point's own rate under a geometry transition.
+fn with_tween<R>(
+    features: &[Feature],
+    t: f64,
+    settings: &WarpSettings,
+    f: impl FnOnce(Tween<'_>) -> Result<R>,
+) -> Result<R> {
     let rates = settings.geometry_rates(features, t)?;
     let rate = |p: Vec2| rates.at(p);
-    let tween = match rates.uniform() {
-        Some(t) => Tween::uniform(t),
-        None => Tween::with_rates(t, &rate),
-    };
-    let frame = || {
-        settings
-            .frame
+    match rates.uniform() {
+        Some(t) => f(Tween::uniform(t)),
+        None => f(Tween::with_rates(t, &rate)),
+    }
+}
+
+impl WarpSettings {
+    /// The frame a scattered-data or triangulated warp covers: the host's
+    /// frame, else the features' bounds.
+    fn scattered_frame(&self, features: &[Feature]) -> Result<RectD> {
+        self.frame
             .or_else(|| feature_bounds(features))
             .ok_or_else(|| {
                 Error::Invalid(format!(
                     "method \"{}\" needs at least one feature point",
-                    settings.method.name()
+                    self.method.name()
                 ))
             })
-    };
-    let pairs = || point_pairs_toward(features, side, tween, settings.samples_per_segment);
-    match settings.method {
-        Method::Field => Ok(Arc::new(FieldWarp::toward(
-            features,
-            side,
-            tween,
-            &settings.field,
-        ))),
-        Method::Mesh => Ok(Arc::new(MeshWarp::toward(
-            settings.mesh_pair()?,
-            side,
-            tween,
-        ))),
-        Method::Triangles => Ok(Arc::new(TriangleWarp::toward(
-            features,
-            side,
-            tween,
-            settings.samples_per_segment,
-            frame()?,
-        )?)),
-        Method::ThinPlate => Ok(Arc::new(ThinPlateWarp::new(ThinPlate::solve(
-            &pairs(),
-            frame()?,
-            &settings.thin_plate,
-            None,
-        )))),
-        Method::Mffd => Ok(Arc::new(MffdWarp {
-            mffd: Mffd::solve(&pairs(), frame()?, &settings.mffd),
-        })),
-        Method::Hybrid => Ok(Arc::new(MffdWarp {
-            mffd: hybrid::solve(&pairs(), frame()?, &settings.hybrid),
-        })),
-        Method::Auto => {
-            let c = settings.correspondence.as_ref().ok_or_else(|| {
-                Error::Invalid(
-                    "method \"auto\" needs both images: its correspondence is solved from A and B (the Morph node, morphfx morph)".into(),
-                )
-            })?;
-            Ok(Arc::new(c.toward(side, tween)))
-        }
     }
 }
 

@@ -7,6 +7,7 @@ use morphfx::image::Plane;
 use morphfx::scene::Scene;
 use morphfx::transition::Weights;
 use morphfx::warp::auto::{Correspondence, Grid};
+use morphfx::warp::thin_plate::ThinPlate;
 
 use crate::cache::{Cache, WarpCache};
 use crate::wrapper::clips::Effect;
@@ -27,6 +28,9 @@ pub struct Instance {
     /// The last solved `auto` grids by frame, for warm starts: `(time,
     /// settings key, grid)`, at most [`GRIDS_KEPT`].
     pub grids: Mutex<Vec<(f64, u64, Grid)>>,
+    /// The last solved thin plates, for warm starts: `(time, settings and
+    /// side key, plates)`, at most [`PLATES_KEPT`].
+    pub plates: Mutex<Vec<(f64, u64, Arc<ThinPlate>)>>,
     /// Per-pixel dissolve weights of non-uniform colour transitions, keyed
     /// like the warps they come from.
     pub weights: Cache<Weights>,
@@ -34,6 +38,9 @@ pub struct Instance {
 
 /// Solved grids kept for warm starts.
 pub const GRIDS_KEPT: usize = 8;
+
+/// Solved plates kept for warm starts (a morph solves two per frame).
+pub const PLATES_KEPT: usize = 4;
 
 /// A morph needs two planes.
 pub const PLANES_KEPT: usize = 2;
@@ -49,6 +56,10 @@ impl Instance {
         self.correspondences.clear();
         self.weights.clear();
         self.grids.lock().unwrap_or_else(|e| e.into_inner()).clear();
+        self.plates
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
     }
 
     /// True the first time `what` is asked about.

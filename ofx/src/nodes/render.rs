@@ -14,12 +14,14 @@ use morphfx::views::{self, View};
 use morphfx::warp::auto::{self, Correspondence, WorkImage};
 use morphfx::warp::hybrid::HybridSettings;
 use morphfx::warp::mesh::{self, MeshPair, Pass};
-use morphfx::warp::{self, WarpMap, WarpSettings};
+use morphfx::warp::thin_plate::multigrid::Report;
+use morphfx::warp::thin_plate::ThinPlateWarp;
+use morphfx::warp::{self, Warp, WarpMap, WarpSettings};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::message::*;
 
-use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT};
+use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT, PLATES_KEPT};
 use super::params::{Settings, OFFSET_A, OFFSET_B};
 use super::NodeKind;
 use crate::cache::key_of;
@@ -337,7 +339,11 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     let map = |side: Side| -> Outcome<Arc<WarpMap>> {
         let key = key_of(&(&frame, side, map_window, scale.x, scale.y));
         instance.warps.get_or_compute(key, || {
-            let w = warp::toward(&frame.features, side, frame.t, &frame.warp)?;
+            let w: Arc<dyn Warp> = if frame.warp.method == Method::ThinPlate {
+                Arc::new(thin_plate(&instance, &frame, side, time)?)
+            } else {
+                warp::toward(&frame.features, side, frame.t, &frame.warp)?
+            };
             Ok::<_, Failure>(w.map_window(map_window, scale))
         })
     };
@@ -502,6 +508,40 @@ fn correspondence(
         grids.push((time, same_setup, c.grid.clone()));
         Ok(c)
     })
+}
+
+/// The frame's thin plates on `side`, solved from the plates this instance
+/// solved nearest in time (this frame at another scale, or a neighbouring
+/// frame of the sequence) with the same settings: seed 003's warm start,
+/// since features move little from frame to frame.
+fn thin_plate(instance: &Instance, frame: &Frame, side: Side, time: f64) -> Outcome<ThinPlateWarp> {
+    let setup = key_of(&(side, &frame.warp.thin_plate, frame.warp.frame));
+    let warm = {
+        let plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+        plates
+            .iter()
+            .filter(|(t, k, _)| *k == setup && (t - time).abs() <= 1.0)
+            .min_by(|a, b| (a.0 - time).abs().total_cmp(&(b.0 - time).abs()))
+            .map(|(_, _, p)| p.clone())
+    };
+    let w = warp::thin_plate_toward(&frame.features, side, frame.t, &frame.warp, warm.as_deref())
+        .map_err(|e| Failure::BadInput(e.to_string()))?;
+    if std::env::var_os("MORPHFX_VERBOSE").is_some() {
+        let cycles = |r: &Report| r.residuals.len() - 1;
+        eprintln!(
+            "thin-plate: frame {time} side {side:?}: {} start, {} + {} cycles",
+            if warm.is_some() { "warm" } else { "cold" },
+            cycles(&w.plate.report_x),
+            cycles(&w.plate.report_y),
+        );
+    }
+    let mut plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+    plates.retain(|(t, k, _)| !(*t == time && *k == setup));
+    if plates.len() >= PLATES_KEPT {
+        plates.remove(0);
+    }
+    plates.push((time, setup, Arc::new(w.plate.clone())));
+    Ok(w)
 }
 
 fn needs_a(view: View) -> bool {
