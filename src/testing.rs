@@ -1,7 +1,22 @@
 //! Generated content with known properties, shared by this project's tests
 //! and benchmarks (the core's, the harness's and the bundle's).
 
-use crate::geom::Vec2;
+use crate::geom::{RectI, Vec2};
+use crate::image::Image;
+
+/// An RGBA plate of `bounds` with a vertical step edge at canonical x =
+/// `edge` (0.1 left of it, 0.9 right, opaque), for snakes to find.
+pub fn step_plate(bounds: RectI, edge: f64) -> Image {
+    Image::from_fn(bounds, 4, |i, _, c| {
+        if c == 3 {
+            1.0
+        } else if (i as f64 + 0.5) < edge {
+            0.1
+        } else {
+            0.9
+        }
+    })
+}
 
 /// A smooth colour field with texture everywhere (no flat region), values in
 /// [0, 1]: what `auto` needs to find a warp, and what 8-bit plates can hold.

@@ -587,12 +587,12 @@ fn snap_lines_keys_each_side_onto_its_own_edge_at_the_current_frame() {
             .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
             .unwrap();
         let fa = Arc::new(Frame::from_image(
-            &common::step_plate(bounds, 24.0),
+            &morphfx::testing::step_plate(bounds, 24.0),
             depth,
             false,
         ));
         let fb = Arc::new(Frame::from_image(
-            &common::step_plate(bounds, 36.0),
+            &morphfx::testing::step_plate(bounds, 36.0),
             depth,
             true,
         ));

@@ -4,15 +4,7 @@ use crate::image::Image;
 
 /// A plate dark left of `edge` and bright right of it (a vertical step).
 fn step(edge: f64) -> Image {
-    Image::from_fn(RectI::from_size(96, 64), 4, |i, _, c| {
-        if c == 3 {
-            1.0
-        } else if (i as f64 + 0.5) < edge {
-            0.1
-        } else {
-            0.9
-        }
-    })
+    crate::testing::step_plate(RectI::from_size(96, 64), edge)
 }
 
 fn polyline(x: f64) -> Vec<Vec2> {

@@ -33,21 +33,6 @@ pub fn run_morphfx(args: &[&str]) -> Output {
         .expect("morphfx runs")
 }
 
-/// A plate of `bounds` with a vertical step edge at canonical x = `edge`
-/// (dark left of it, bright right), for snakes to find.
-#[allow(dead_code)] // not every test file snaps
-pub fn step_plate(bounds: morphfx::geom::RectI, edge: f64) -> morphfx::image::Image {
-    morphfx::image::Image::from_fn(bounds, 4, |i, _, c| {
-        if c == 3 {
-            1.0
-        } else if (i as f64 + 0.5) < edge {
-            0.1
-        } else {
-            0.9
-        }
-    })
-}
-
 /// An opaque `w × h` float EXR at `path` whose pixel centres take `colour`
 /// (canonical position in, RGB out); returns the image written.
 #[allow(dead_code)] // not every test file writes generated plates
