@@ -160,7 +160,7 @@ impl Stencil {
         let n = j * nx + i;
         let row = self.row(n);
         if i >= r && j >= r && i + r < nx && j + r < ny {
-            return window_sum::<S>(row, f, n, nx, None);
+            return window_sum::<S>(row, f, n, nx, false);
         }
         let (i, j, r) = (i as i64, j as i64, r as i64);
         let mut v = 0.0;
@@ -231,7 +231,7 @@ impl Stencil {
                 let k = k0 + nth(step, inner);
                 let (row, inverse) = self.row_and_inverse(k);
                 let base = k - r;
-                let mut v = window_sum::<S>(row, f, k, nx, Some(()));
+                let mut v = window_sum::<S>(row, f, k, nx, true);
                 for t in ahead.clone() {
                     v += row[centre + t] * f[base + t];
                 }
@@ -354,14 +354,14 @@ fn window_sum<const S: usize>(
     f: &[f64],
     n: usize,
     nx: usize,
-    skip_centre: Option<()>,
+    skip_centre: bool,
 ) -> f64 {
     let r = S / 2;
     let base = n - r * nx - r;
     let mut v = f64x4::ZERO;
     let mut tail = 0.0;
     for dy in 0..S {
-        if skip_centre.is_some() && dy == r {
+        if skip_centre && dy == r {
             continue;
         }
         let f = &f[base + dy * nx..base + dy * nx + S];
@@ -412,6 +412,8 @@ pub struct Hierarchy {
     /// The finest plate (its springs give the right-hand sides).
     pub plate: Plate,
     pub levels: Vec<Stencil>,
+    /// `transfers[l]`: between level `l` and `l + 1`.
+    transfers: Vec<Transfer>,
     coarse: Cholesky,
 }
 
@@ -443,9 +445,14 @@ impl Hierarchy {
             stencils.push(next);
         }
         let coarse = Cholesky::of(&stencils[stencils.len() - 1]);
+        let transfers = stencils[..stencils.len() - 1]
+            .iter()
+            .map(|s| Transfer::new(s.nx, s.ny))
+            .collect();
         Hierarchy {
             plate,
             levels: stencils,
+            transfers,
             coarse,
         }
     }
@@ -518,52 +525,73 @@ impl Hierarchy {
             a.relax(f, b, true);
         }
         let r = a.residual(f, b);
-        let coarse = &self.levels[l + 1];
-        let rc = restrict(a, coarse, &r);
+        let rc = self.transfers[l].restrict(&r);
         let mut e = vec![0.0; rc.len()];
         self.cycle(l + 1, &mut e, &rc);
-        prolong_add(coarse, a, &e, f);
+        self.transfers[l].prolong_add(&e, f);
         for _ in 0..POST {
             a.relax(f, b, false);
         }
     }
 }
 
-/// `Pᵀ r`, separable (rows, then columns).
-fn restrict(fine: &Stencil, coarse: &Stencil, r: &[f64]) -> Vec<f64> {
-    let (nx, cx) = (fine.nx, coarse.nx);
-    let columns: Vec<Vec<(usize, f64)>> = (0..cx).map(|c| children(c, nx).collect()).collect();
-    let mut wide = vec![0.0; cx * fine.ny];
-    for (row, out) in r.chunks_exact(nx).zip(wide.chunks_exact_mut(cx)) {
-        for (o, column) in out.iter_mut().zip(&columns) {
-            *o = column.iter().map(|&(x, w)| w * row[x]).sum();
-        }
-    }
-    let mut rc = vec![0.0; cx * coarse.ny];
-    for (jc, out) in rc.chunks_exact_mut(cx).enumerate() {
-        for (y, wy) in children(jc, fine.ny) {
-            for (o, v) in out.iter_mut().zip(&wide[y * cx..(y + 1) * cx]) {
-                *o += wy * v;
-            }
-        }
-    }
-    rc
+/// `P` between a fine grid and the grid of every other node, per axis, as
+/// tables built once per level: which coarse nodes each fine node reads
+/// (`parents`) and which fine nodes each coarse node feeds (`children`).
+struct Transfer {
+    fine: (usize, usize),
+    coarse: (usize, usize),
+    parents: [Vec<Vec<(usize, f64)>>; 2],
+    children: [Vec<Vec<(usize, f64)>>; 2],
 }
 
-/// `f += P e`: a coarse row interpolated in y once per fine row, then in x.
-fn prolong_add(coarse: &Stencil, fine: &Stencil, e: &[f64], f: &mut [f64]) {
-    let (cx, cy) = (coarse.nx, coarse.ny);
-    let from: Vec<Vec<(usize, f64)>> = (0..fine.nx).map(|x| parents(x, cx).collect()).collect();
-    let mut mixed = vec![0.0; cx];
-    for (y, out) in f.chunks_exact_mut(fine.nx).enumerate() {
-        mixed.fill(0.0);
-        for (c, wy) in parents(y, cy) {
-            for (m, v) in mixed.iter_mut().zip(&e[c * cx..(c + 1) * cx]) {
-                *m += wy * v;
+impl Transfer {
+    fn new(nx: usize, ny: usize) -> Transfer {
+        let (cx, cy) = ((nx - 1) / 2 + 1, (ny - 1) / 2 + 1);
+        let up = |n: usize, cn: usize| (0..n).map(|x| parents(x, cn).collect()).collect();
+        let down = |n: usize, cn: usize| (0..cn).map(|c| children(c, n).collect()).collect();
+        Transfer {
+            fine: (nx, ny),
+            coarse: (cx, cy),
+            parents: [up(nx, cx), up(ny, cy)],
+            children: [down(nx, cx), down(ny, cy)],
+        }
+    }
+
+    /// `Pᵀ r`, separable (rows, then columns).
+    fn restrict(&self, r: &[f64]) -> Vec<f64> {
+        let ((nx, ny), (cx, cy)) = (self.fine, self.coarse);
+        let mut wide = vec![0.0; cx * ny];
+        for (row, out) in r.chunks_exact(nx).zip(wide.chunks_exact_mut(cx)) {
+            for (o, column) in out.iter_mut().zip(&self.children[0]) {
+                *o = column.iter().map(|&(x, w)| w * row[x]).sum();
             }
         }
-        for (o, from) in out.iter_mut().zip(&from) {
-            *o += from.iter().map(|&(c, w)| w * mixed[c]).sum::<f64>();
+        let mut rc = vec![0.0; cx * cy];
+        for (out, rows) in rc.chunks_exact_mut(cx).zip(&self.children[1]) {
+            for &(y, wy) in rows {
+                for (o, v) in out.iter_mut().zip(&wide[y * cx..(y + 1) * cx]) {
+                    *o += wy * v;
+                }
+            }
+        }
+        rc
+    }
+
+    /// `f += P e`: a coarse row interpolated in y once per fine row, then in x.
+    fn prolong_add(&self, e: &[f64], f: &mut [f64]) {
+        let cx = self.coarse.0;
+        let mut mixed = vec![0.0; cx];
+        for (out, rows) in f.chunks_exact_mut(self.fine.0).zip(&self.parents[1]) {
+            mixed.fill(0.0);
+            for &(c, wy) in rows {
+                for (m, v) in mixed.iter_mut().zip(&e[c * cx..(c + 1) * cx]) {
+                    *m += wy * v;
+                }
+            }
+            for (o, from) in out.iter_mut().zip(&self.parents[0]) {
+                *o += from.iter().map(|&(c, w)| w * mixed[c]).sum::<f64>();
+            }
         }
     }
 }
@@ -634,36 +662,32 @@ mod tests {
     use super::*;
     use crate::testing::Lcg;
 
-    fn grid(nx: usize, ny: usize) -> Stencil {
-        Stencil::new(nx, ny, 5, vec![1.0; 25], vec![0; nx * ny])
-    }
-
     #[test]
     fn restriction_is_the_transpose_of_prolongation() {
-        let (fine, coarse) = (grid(17, 13), grid(9, 7));
+        let transfer = Transfer::new(17, 13);
         let mut r = Lcg::new(3);
         let e: Vec<f64> = (0..9 * 7).map(|_| r.range(-1.0, 1.0)).collect();
         let v: Vec<f64> = (0..17 * 13).map(|_| r.range(-1.0, 1.0)).collect();
         let mut pe = vec![0.0; 17 * 13];
-        prolong_add(&coarse, &fine, &e, &mut pe);
+        transfer.prolong_add(&e, &mut pe);
         let lhs: f64 = pe.iter().zip(&v).map(|(a, b)| a * b).sum();
         let rhs: f64 = e
             .iter()
-            .zip(restrict(&fine, &coarse, &v))
+            .zip(transfer.restrict(&v))
             .map(|(a, b)| a * b)
             .sum();
         assert!(
             (lhs - rhs).abs() < 1e-12 * lhs.abs().max(1.0),
             "{lhs} vs {rhs}"
         );
-        // Bilinear: a linear function on the coarse grid is the same
+        // A linear function on the coarse grid is the same
         // function on the fine one (coarse node (i, j) is fine (2i, 2j)).
         let linear = |x: f64, y: f64| 3.0 * x - 2.0 * y + 1.0;
         let e: Vec<f64> = (0..9 * 7)
             .map(|k| linear(2.0 * (k % 9) as f64, 2.0 * (k / 9) as f64))
             .collect();
         let mut f = vec![0.0; 17 * 13];
-        prolong_add(&coarse, &fine, &e, &mut f);
+        transfer.prolong_add(&e, &mut f);
         for (k, v) in f.iter().enumerate() {
             assert!((v - linear((k % 17) as f64, (k / 17) as f64)).abs() < 1e-12);
         }
