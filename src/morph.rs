@@ -1,7 +1,8 @@
 //! The in-between image: both sources warped toward the same feature positions
 //! and dissolved (seed 002 §3.4).
 
-use crate::image::resample::{adapt_channels, fill_rows, row_through};
+use crate::image::bilinear_rgba::{blend_row, Taps};
+use crate::image::resample::{adapt_channels, fill_rows, map_span, row_through};
 use crate::image::{Plane, RowsMut, Sample, Sampler};
 use crate::transition::Weights;
 use crate::warp::WarpMap;
@@ -70,8 +71,34 @@ pub fn dissolve<S: Sample, D: Sample>(
 ) {
     let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
+    // Both sources float RGBA through maps (the usual host plates): sampled
+    // and blended pixel by pixel in one pass.
+    let direct = match (a, b) {
+        (Warped::Map(sa, ma), Warped::Map(sb, mb)) if dc == 4 => Taps::of(sa)
+            .zip(Taps::of(sb))
+            .map(|taps| (taps, (sa, ma), (sb, mb))),
+        _ => None,
+    };
     fill_rows(dst, dc, |j, x1, row, other| {
         let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| src.row_as(j, x1, dc, out);
+        let spans = direct.as_ref().and_then(|(_, (_, ma), (_, mb))| {
+            map_span(ma, j, x1, row.len()).zip(map_span(mb, j, x1, row.len()))
+        });
+        if let (Some(((ta, tb), (sa, _), (sb, _))), Some((pa, pb))) = (&direct, spans) {
+            if wa != 0.0 && wb != 0.0 {
+                let slow = |s: &Sampler<'_, S>, p: &[[f32; 2]], n: usize| {
+                    let mut v = [0f32; 4];
+                    s.sample(p[n][0], p[n][1], &mut v);
+                    v
+                };
+                blend_row(
+                    (ta, pa, wa, |n| slow(sa, pa, n)),
+                    (tb, pb, wb, |n| slow(sb, pb, n)),
+                    row,
+                );
+                return;
+            }
+        }
         if wb == 0.0 {
             warped(&a, row);
         } else if wa == 0.0 {

@@ -18,6 +18,31 @@ pub fn step_plate(bounds: RectI, edge: f64) -> Image {
     })
 }
 
+/// Positions that exercise every path of a sampler row: inside (most), on and
+/// near pixel centres, across each edge, outside and NaN; canonical
+/// positions over `bounds` at scale 1, deterministic in `seed`.
+pub fn awkward_positions(bounds: RectI, n: usize, seed: u64) -> Vec<[f32; 2]> {
+    let mut s = seed;
+    let mut r = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let (x1, y1) = (bounds.x1 as f32, bounds.y1 as f32);
+    let (w, h) = (bounds.width() as f32, bounds.height() as f32);
+    (0..n)
+        .map(|k| match k % 11 {
+            0 => [x1 + 3.5, y1 + 2.5],
+            1 => [x1 + 4.5 + 3e-5, y1 + 1.5],
+            2 => [x1 - 3.0 + (w + 6.0) * r(), y1 - 3.0 + (h + 6.0) * r()],
+            3 => [f32::NAN, y1 + 1.0],
+            4 => [x1 + w - 0.7 * r(), y1 + h * r()],
+            _ => [x1 + w * r(), y1 + h * r()],
+        })
+        .collect()
+}
+
 /// A smooth colour field with texture everywhere (no flat region), values in
 /// [0, 1]: what `auto` needs to find a warp, and what 8-bit plates can hold.
 /// Canonical pixel position in, RGB out.

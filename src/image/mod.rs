@@ -5,6 +5,7 @@
 //! A view's rows are addressed bottom-up in canonical pixel indices: pixel
 //! `(i, j)` of `bounds` starts at `base + (j - y1) * row_stride + (i - x1) * channels`.
 
+pub(crate) mod bilinear_rgba;
 pub mod resample;
 mod sample;
 

@@ -128,6 +128,18 @@ pub fn through<S: Sample, D: Sample>(sampler: &Sampler<'_, S>, map: &WarpMap, ds
     });
 }
 
+/// The map's positions for pixels `x1..x1 + len` of row `j`, when it holds
+/// them all (not for the identity map, nor a span its window cuts).
+pub(crate) fn map_span(map: &WarpMap, j: i32, x1: i32, len: usize) -> Option<&[[f32; 2]]> {
+    let w = map.window;
+    let x2 = x1 + len as i32;
+    if j < w.y1 || j >= w.y2 || x1 < w.x1 || x2 > w.x2 {
+        return None;
+    }
+    let positions = map.row(j)?;
+    Some(&positions[(x1 - w.x1) as usize..(x2 - w.x1) as usize])
+}
+
 /// Row `j` of `sampler` seen through `map`, pixels `x1..x1 + row.len()`;
 /// pixels outside the map's window are transparent black.
 pub(crate) fn row_through<S: Sample>(

@@ -3,6 +3,7 @@
 
 use wide::f32x8;
 
+use super::bilinear_rgba::{self, Taps};
 use super::{ImageView, Sample};
 use crate::geom::{PixelScale, RectI};
 
@@ -77,7 +78,7 @@ impl EdgeMode {
 
 /// Fractions this close to a pixel centre snap to it, so warps that land on
 /// centres up to float round-off copy pixels exactly instead of blurring.
-const SNAP: f32 = 1e-4;
+pub(crate) const SNAP: f32 = 1e-4;
 
 /// Samples one image; at most 4 channels.
 #[derive(Debug, Clone, Copy)]
@@ -112,6 +113,16 @@ impl<'a, T: Sample> Sampler<'a, T> {
     #[inline]
     pub fn channels(&self) -> usize {
         self.view.channels()
+    }
+
+    #[inline]
+    pub(crate) fn view(&self) -> ImageView<'a, T> {
+        self.view
+    }
+
+    #[inline]
+    pub fn filter(&self) -> Filter {
+        self.filter
     }
 
     #[inline]
@@ -227,7 +238,12 @@ impl<'a, T: Sample> Sampler<'a, T> {
         match (self.view.channels(), self.alpha_weighted, cubic) {
             (4, true, false) => self.row::<4, true, false>(positions, out),
             (4, true, true) => self.row::<4, true, true>(positions, out),
-            (4, false, false) => self.row::<4, false, false>(positions, out),
+            (4, false, false) => match Taps::of(self) {
+                Some(taps) => bilinear_rgba::row(&taps, positions, out, |n, o| {
+                    self.sample(positions[n][0], positions[n][1], o)
+                }),
+                None => self.row::<4, false, false>(positions, out),
+            },
             (4, false, true) => self.row::<4, false, true>(positions, out),
             (3, _, false) => self.row::<3, false, false>(positions, out),
             (3, _, true) => self.row::<3, false, true>(positions, out),

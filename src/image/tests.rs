@@ -139,3 +139,49 @@ fn straight_alpha_filtering_does_not_bleed_transparent_colour() {
     s.sample(1.0, 0.5, &mut px);
     assert_eq!(px, [1.0, 0.0, 0.0, 0.5]);
 }
+
+/// The direct float RGBA path addresses taps from the buffer's origin and
+/// stride: a top-down, padded buffer with an offset must give exactly what a
+/// packed one gives, and both what each position's bilinear blend is.
+#[test]
+fn direct_float_rgba_sampling_reads_any_layout_exactly() {
+    let bounds = RectI::new(-7, 3, 30, 25);
+    let img = Image::from_fn(bounds, 4, |i, j, c| {
+        ((i * 37 + j * 101 + c as i32 * 7) % 97) as f32 / 97.0 - 0.3
+    });
+    let (w, h) = (img.width(), img.height());
+    // Top row first, 5 pixels of padding per row, 11 samples of lead-in.
+    let (pad, lead) = (20, 11);
+    let stride = w * 4 + pad;
+    let mut flipped = vec![f32::NAN; lead + h * stride];
+    for r in 0..h {
+        let at = lead + (h - 1 - r) * stride;
+        flipped[at..at + w * 4].copy_from_slice(&img.data[r * w * 4..(r + 1) * w * 4]);
+    }
+    let layout = Layout {
+        bounds,
+        channels: 4,
+        base: lead + (h - 1) * stride,
+        row_stride: -(stride as isize),
+    };
+    let flipped = ImageView::new(&flipped, layout).unwrap();
+    let positions = crate::testing::awkward_positions(bounds, 1003, 5);
+    for edge in [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror] {
+        let sampler = |view| Sampler::new(view, PixelScale::UNIT, Filter::Bilinear, edge, true);
+        let (packed, top_down) = (sampler(img.view()), sampler(flipped));
+        let mut want = vec![[0f32; 4]; positions.len()];
+        let mut got = want.clone();
+        packed.sample_row(&positions, &mut want);
+        top_down.sample_row(&positions, &mut got);
+        for ((p, g), w) in positions.iter().zip(&got).zip(&want) {
+            let same = g.iter().zip(w).all(|(g, w)| g.to_bits() == w.to_bits());
+            assert!(same, "{edge:?} at {p:?}: {g:?} vs {w:?}");
+            let mut one = [0f32; 4];
+            packed.sample(p[0], p[1], &mut one);
+            for c in 0..4 {
+                let ok = (g[c] - one[c]).abs() <= 1e-5 || (g[c].is_nan() && one[c].is_nan());
+                assert!(ok, "{edge:?} at {p:?}: {g:?} vs one sample {one:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,166 @@
+//! Bilinear float RGBA, premultiplied: the plate a host usually sends, and
+//! nearly the whole cost of a morph frame once its warps are cached.
+//!
+//! The general sampler row ([`super::Sampler::sample_row`]) finds each pixel's
+//! row through the view and checks slices per tap; here each tap pair is
+//! addressed from the buffer's origin and stride, so a pixel is a few integer
+//! operations and two eight-wide loads. The dissolve samples both sources of a
+//! pixel in the same iteration ([`blend_row`]): four independent loads close
+//! together keep more of them in flight, and no second row is written and read
+//! back. Values are bit for bit those of the general path and of the separate
+//! blend (same operations in the same order); positions it does not take
+//! (taps outside the image, on or near a pixel centre, NaN) go to the caller's
+//! one-pixel fallback.
+
+use wide::f32x8;
+
+use super::sample::SNAP;
+use super::{Filter, Sample, Sampler};
+
+/// A source sampled by direct addressing; see [`Taps::of`].
+#[derive(Clone, Copy)]
+pub(crate) struct Taps<'a> {
+    data: &'a [f32],
+    /// Index of pixel (0, 0)'s first sample; may lie outside `data`, only
+    /// inside pixels are addressed from it.
+    origin: isize,
+    /// Samples from one row to the next row up.
+    stride: isize,
+    /// Canonical position to pixel index, x and y interleaved as positions are.
+    scale: f32x8,
+    /// Both taps inside: `lo ≤ index < hi` per axis, interleaved likewise.
+    lo: f32x8,
+    hi: f32x8,
+}
+
+/// Four positions (one eight-wide vector of x, y pairs) located in a source.
+struct Located {
+    /// Two bits per pixel (x, y): set where that axis takes the fast path.
+    fast: u32,
+    /// Integer pixel index, interleaved.
+    whole: [i32; 8],
+    /// Fractions (weights of the right and upper taps), interleaved.
+    t: [f32; 8],
+}
+
+impl<'a> Taps<'a> {
+    /// Direct taps for a bilinear, premultiplied float RGBA sampler; `None`
+    /// for any other kind, which takes the general path.
+    pub(crate) fn of<T: Sample>(sampler: &Sampler<'a, T>) -> Option<Self> {
+        let view = sampler.view();
+        if sampler.filter() != Filter::Bilinear || view.channels() != 4 || sampler.alpha_weighted()
+        {
+            return None;
+        }
+        let data = T::as_f32(view.data)?;
+        let (b, layout, scale) = (view.bounds(), view.layout, sampler.scale());
+        let pairs = |x: f32, y: f32| f32x8::new([x, y, x, y, x, y, x, y]);
+        Some(Taps {
+            data,
+            origin: layout.base as isize - b.x1 as isize * 4 - b.y1 as isize * layout.row_stride,
+            stride: layout.row_stride,
+            scale: pairs(scale.x as f32, scale.y as f32),
+            lo: pairs(b.x1 as f32, b.y1 as f32),
+            hi: pairs((b.x2 - 1) as f32, (b.y2 - 1) as f32),
+        })
+    }
+
+    #[inline(always)]
+    fn locate(&self, positions: &[f32; 8]) -> Located {
+        let s = f32x8::splat;
+        // Continuous pixel index: integers are pixel centres.
+        let f = f32x8::new(*positions) * self.scale - s(0.5);
+        let whole = f.floor();
+        let t = f - whole;
+        // NaN fails every comparison, so it takes the fallback too; so do
+        // fractions near a centre line, which the fallback snaps.
+        let fast =
+            f.simd_ge(self.lo) & f.simd_lt(self.hi) & t.simd_gt(s(SNAP)) & t.simd_lt(s(1.0 - SNAP));
+        Located {
+            fast: fast.to_bitmask(),
+            whole: whole.fast_trunc_int().to_array(),
+            t: t.to_array(),
+        }
+    }
+
+    /// Pixel `k` of a located four, both axes on the fast path.
+    #[inline(always)]
+    fn pixel(&self, l: &Located, k: usize) -> [f32; 4] {
+        let (x, y) = (2 * k, 2 * k + 1);
+        let at = self.origin + l.whole[x] as isize * 4 + l.whole[y] as isize * self.stride;
+        let load = |at: isize| {
+            let at = at as usize;
+            f32x8::new(*self.data[at..at + 8].first_chunk().unwrap())
+        };
+        let (below, above) = (load(at), load(at + self.stride));
+        // Each row's pair of horizontal neighbours blended vertically, then
+        // the two halves horizontally.
+        let v = (below + (above - below) * f32x8::splat(l.t[y])).to_array();
+        let tx = l.t[x];
+        std::array::from_fn(|c| v[c] + (v[4 + c] - v[c]) * tx)
+    }
+}
+
+/// The eight floats of each group of four positions.
+fn groups(positions: &[[f32; 2]]) -> &[[f32; 8]] {
+    positions.as_flattened().as_chunks::<8>().0
+}
+
+/// Samples `taps` at each of `positions` into `out`; `slow(n, out)` computes
+/// pixel `n` wherever the direct path does not apply.
+pub(crate) fn row(
+    taps: &Taps<'_>,
+    positions: &[[f32; 2]],
+    out: &mut [[f32; 4]],
+    slow: impl Fn(usize, &mut [f32; 4]),
+) {
+    assert_eq!(positions.len(), out.len(), "one position per pixel");
+    let four = groups(positions);
+    for (g, (p, outs)) in four.iter().zip(out.chunks_exact_mut(4)).enumerate() {
+        let l = taps.locate(p);
+        for (k, o) in outs.iter_mut().enumerate() {
+            if (l.fast >> (2 * k)) & 3 == 3 {
+                *o = taps.pixel(&l, k);
+            } else {
+                slow(4 * g + k, o);
+            }
+        }
+    }
+    for (n, o) in out.iter_mut().enumerate().skip(four.len() * 4) {
+        slow(n, o);
+    }
+}
+
+/// `out = wa · A + wb · B`, A sampled at `pa` and B at `pb`, both sources of
+/// a pixel in one iteration; each source's `slow(n)` gives its pixel `n`
+/// wherever the direct path does not apply to it.
+pub(crate) fn blend_row(
+    (a, pa, wa, slow_a): (&Taps<'_>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
+    (b, pb, wb, slow_b): (&Taps<'_>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
+    out: &mut [[f32; 4]],
+) {
+    assert!(
+        pa.len() == out.len() && pb.len() == out.len(),
+        "one position per pixel and source"
+    );
+    let blend = |va: [f32; 4], vb: [f32; 4]| std::array::from_fn(|c| wa * va[c] + wb * vb[c]);
+    let (four_a, four_b) = (groups(pa), groups(pb));
+    let pixels = out.chunks_exact_mut(4);
+    for (g, ((qa, qb), outs)) in four_a.iter().zip(four_b).zip(pixels).enumerate() {
+        let (la, lb) = (a.locate(qa), b.locate(qb));
+        for (k, o) in outs.iter_mut().enumerate() {
+            let (fast_a, fast_b) = ((la.fast >> (2 * k)) & 3 == 3, (lb.fast >> (2 * k)) & 3 == 3);
+            *o = if fast_a && fast_b {
+                blend(a.pixel(&la, k), b.pixel(&lb, k))
+            } else {
+                let n = 4 * g + k;
+                let va = if fast_a { a.pixel(&la, k) } else { slow_a(n) };
+                let vb = if fast_b { b.pixel(&lb, k) } else { slow_b(n) };
+                blend(va, vb)
+            };
+        }
+    }
+    for (n, o) in out.iter_mut().enumerate().skip(four_a.len() * 4) {
+        *o = blend(slow_a(n), slow_b(n));
+    }
+}
