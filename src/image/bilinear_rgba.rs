@@ -12,7 +12,7 @@
 //! (taps outside the image, on or near a pixel centre, NaN) go to the caller's
 //! one-pixel fallback.
 
-use wide::f32x8;
+use wide::{f32x8, i32x8};
 
 use super::sample::SNAP;
 use super::{Filter, Sample, Sampler};
@@ -21,11 +21,15 @@ use super::{Filter, Sample, Sampler};
 #[derive(Clone, Copy)]
 pub(crate) struct Taps<'a> {
     data: &'a [f32],
-    /// Index of pixel (0, 0)'s first sample; may lie outside `data`, only
-    /// inside pixels are addressed from it.
-    origin: isize,
+    /// Index of the first sample of the bounds' corner pixel.
+    base: i32,
     /// Samples from one row to the next row up.
-    stride: isize,
+    stride: i32,
+    /// Samples per pixel and per row, interleaved: a pixel's offset from
+    /// `base` is the sum of a pair of its index (relative to the corner)
+    /// times these. All `i32`: buffers this path takes are shorter than
+    /// `i32::MAX`, and inside pixels' offsets lie within them.
+    step: i32x8,
     /// Canonical position to pixel index, x and y interleaved as positions are.
     scale: f32x8,
     /// Both taps inside: `lo ≤ index < hi` per axis, interleaved likewise.
@@ -37,8 +41,8 @@ pub(crate) struct Taps<'a> {
 struct Located {
     /// Two bits per pixel (x, y): set where that axis takes the fast path.
     fast: u32,
-    /// Integer pixel index, interleaved.
-    whole: [i32; 8],
+    /// Offsets from `base` of each pixel's column and row, interleaved.
+    offsets: [i32; 8],
     /// Fractions (weights of the right and upper taps), interleaved.
     t: [f32; 8],
 }
@@ -54,11 +58,16 @@ impl<'a> Taps<'a> {
         }
         let data = T::as_f32(view.data)?;
         let (b, layout, scale) = (view.bounds(), view.layout, sampler.scale());
+        if data.len() > i32::MAX as usize || layout.row_stride.unsigned_abs() > i32::MAX as usize {
+            return None;
+        }
+        let stride = layout.row_stride as i32;
         let pairs = |x: f32, y: f32| f32x8::new([x, y, x, y, x, y, x, y]);
         Some(Taps {
             data,
-            origin: layout.base as isize - b.x1 as isize * 4 - b.y1 as isize * layout.row_stride,
-            stride: layout.row_stride,
+            base: layout.base as i32,
+            stride,
+            step: i32x8::new([4, stride, 4, stride, 4, stride, 4, stride]),
             scale: pairs(scale.x as f32, scale.y as f32),
             lo: pairs(b.x1 as f32, b.y1 as f32),
             hi: pairs((b.x2 - 1) as f32, (b.y2 - 1) as f32),
@@ -78,7 +87,7 @@ impl<'a> Taps<'a> {
             f.simd_ge(self.lo) & f.simd_lt(self.hi) & t.simd_gt(s(SNAP)) & t.simd_lt(s(1.0 - SNAP));
         Located {
             fast: fast.to_bitmask(),
-            whole: whole.fast_trunc_int().to_array(),
+            offsets: ((whole - self.lo).fast_trunc_int() * self.step).to_array(),
             t: t.to_array(),
         }
     }
@@ -87,9 +96,11 @@ impl<'a> Taps<'a> {
     #[inline(always)]
     fn pixel(&self, l: &Located, k: usize) -> [f32; 4] {
         let (x, y) = (2 * k, 2 * k + 1);
-        let at = self.origin + l.whole[x] as isize * 4 + l.whole[y] as isize * self.stride;
-        let load = |at: isize| {
-            let at = at as usize;
+        // Indices inside the buffer, which fits `i32`; through `u32` the
+        // slice end cannot overflow, so one check per load remains.
+        let at = self.base + l.offsets[x] + l.offsets[y];
+        let load = |at: i32| {
+            let at = at as u32 as usize;
             f32x8::new(*self.data[at..at + 8].first_chunk().unwrap())
         };
         let (below, above) = (load(at), load(at + self.stride));
