@@ -110,7 +110,7 @@ pub fn dissolve<S: Sample, D: Sample>(
             warped(&b, other);
             for (pa, pb) in row.iter_mut().zip(other.iter()) {
                 for c in 0..4 {
-                    pa[c] = wa * pa[c] + wb * pb[c];
+                    pa[c] = wb.mul_add(pb[c], wa * pa[c]);
                 }
             }
         }

@@ -7,10 +7,10 @@
 //! operations and two eight-wide loads. The dissolve samples both sources of a
 //! pixel in the same iteration ([`blend_row`]): four independent loads close
 //! together keep more of them in flight, and no second row is written and read
-//! back. Values are bit for bit those of the general path and of the separate
-//! blend (same operations in the same order); positions it does not take
-//! (taps outside the image, on or near a pixel centre, NaN) go to the caller's
-//! one-pixel fallback.
+//! back. Values are bit for bit those of the general path for other sample
+//! types and of the separate blend (the same fused multiply-adds in the same
+//! order). Positions it does not take (taps outside the image, on or near a
+//! pixel centre, NaN) go to the caller's one-pixel fallback.
 
 use wide::{f32x8, i32x8};
 
@@ -106,9 +106,11 @@ impl<'a> Taps<'a> {
         let (below, above) = (load(at), load(at + self.stride));
         // Each row's pair of horizontal neighbours blended vertically, then
         // the two halves horizontally.
-        let v = (below + (above - below) * f32x8::splat(l.t[y])).to_array();
+        let v = (above - below)
+            .mul_add(f32x8::splat(l.t[y]), below)
+            .to_array();
         let tx = l.t[x];
-        std::array::from_fn(|c| v[c] + (v[4 + c] - v[c]) * tx)
+        std::array::from_fn(|c| (v[4 + c] - v[c]).mul_add(tx, v[c]))
     }
 }
 
@@ -154,7 +156,7 @@ pub(crate) fn blend_row(
         pa.len() == out.len() && pb.len() == out.len(),
         "one position per pixel and source"
     );
-    let blend = |va: [f32; 4], vb: [f32; 4]| std::array::from_fn(|c| wa * va[c] + wb * vb[c]);
+    let blend = |va: [f32; 4], vb: [f32; 4]| std::array::from_fn(|c| wb.mul_add(vb[c], wa * va[c]));
     let (four_a, four_b) = (groups(pa), groups(pb));
     let pixels = out.chunks_exact_mut(4);
     for (g, ((qa, qb), outs)) in four_a.iter().zip(four_b).zip(pixels).enumerate() {

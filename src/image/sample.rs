@@ -343,8 +343,8 @@ impl<'a, T: Sample> Sampler<'a, T> {
             }
         };
         let (below, above) = (load(j0), load(j0 + 1));
-        let v = (below + (above - below) * f32x8::splat(ty)).to_array();
-        let acc: [f32; 4] = std::array::from_fn(|c| v[c] + (v[4 + c] - v[c]) * tx);
+        let v = (above - below).mul_add(f32x8::splat(ty), below).to_array();
+        let acc: [f32; 4] = std::array::from_fn(|c| (v[4 + c] - v[c]).mul_add(tx, v[c]));
         if AW {
             unweight(acc)
         } else {

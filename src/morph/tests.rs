@@ -135,7 +135,7 @@ fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
             through(&sb, &mb, rb.view_mut().rows());
             let (wa, wb) = ((1.0 - t) as f32, t as f32);
             for (k, g) in got.data.iter().enumerate() {
-                let want = wa * ra.data[k] + wb * rb.data[k];
+                let want = wb.mul_add(rb.data[k], wa * ra.data[k]);
                 assert!(
                     g.to_bits() == want.to_bits(),
                     "t {t}, sample {k}: {g} vs {want}"
