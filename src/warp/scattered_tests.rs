@@ -486,6 +486,40 @@ fn a_sweep_is_gauss_seidel_node_by_node() {
     }
 }
 
+/// The hierarchy builds each level as bending (one row per class of node
+/// near the edges) plus springs restricted one by one; that must be exactly
+/// the plate probed node by node and its Galerkin products `Pᵀ A P` built
+/// row by row, on grids large enough for interior classes and small enough
+/// for none, with springs in corners, on edges and clustered.
+#[test]
+fn split_levels_equal_the_direct_galerkin_products() {
+    for (seed, nx, ny, levels) in [(2, 65, 49, 4), (7, 33, 17, 3), (4, 9, 9, 2)] {
+        let mut r = Lcg::new(seed);
+        let (w, h) = ((nx - 1) as f64, (ny - 1) as f64);
+        let mut at: Vec<(f64, f64)> = vec![(0.0, 0.0), (w, h), (0.3, h * 0.5), (w - 0.2, 1.7)];
+        at.extend((0..25).map(|_| (r.range(0.0, w), r.range(0.0, h))));
+        at.extend((0..6).map(|_| (r.range(10.0, 11.0), r.range(4.0, 5.0))));
+        let hierarchy = Hierarchy::new(nx, ny, 3.0, 50.0, 1e-3, &at, levels);
+        let mut direct = Stencil::of(&hierarchy.plate);
+        for (l, level) in hierarchy.levels.iter().enumerate() {
+            if l > 0 {
+                direct = direct.galerkin();
+            }
+            assert_eq!((level.nx, level.ny), (direct.nx, direct.ny));
+            for n in 0..level.nx * level.ny {
+                let (got, want) = (level.row(n), direct.row(n));
+                let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (k, (g, d)) in got.iter().zip(want).enumerate() {
+                    assert!(
+                        (g - d).abs() <= 1e-12 * scale,
+                        "{nx}x{ny} level {l} node {n} tap {k}: {g} vs {d}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn unit(n: usize, k: usize) -> Vec<f64> {
     let mut u = vec![0.0; n];
     u[k] = 1.0;
