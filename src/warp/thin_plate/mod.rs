@@ -100,8 +100,8 @@ impl ThinPlate {
 
 /// The node grid over `frame` and every constraint: cell counts padded to a
 /// multiple of `2^(levels − 1)` (evenly on both sides) so each coarser grid's
-/// nodes are every other node of the finer one, down to a grid of at most
-/// about 8 cells along its longer side for the direct solve.
+/// nodes are every other node of the finer one, down to a grid of 16 to 31
+/// cells along its longer side for the (banded) direct solve.
 fn layout(frame: RectD, pairs: &[(Vec2, Vec2)], cell: f64) -> (Vec2, usize, usize, usize) {
     let area = frame.including(pairs.iter().map(|(p, _)| *p));
     let (min, max) = (Vec2::new(area.x1, area.y1), Vec2::new(area.x2, area.y2));
@@ -109,7 +109,7 @@ fn layout(frame: RectD, pairs: &[(Vec2, Vec2)], cell: f64) -> (Vec2, usize, usiz
     let cy = ((max.y - min.y) / cell).ceil().max(1.0) as usize;
     let (short, long) = (cx.min(cy), cx.max(cy));
     let mut k = 0;
-    while long >> (k + 1) >= 8 && short >> (k + 1) >= 1 {
+    while long >> (k + 1) >= 16 && short >> (k + 1) >= 1 {
         k += 1;
     }
     let unit = 1usize << k;
