@@ -22,13 +22,8 @@ pub fn step_plate(bounds: RectI, edge: f64) -> Image {
 /// near pixel centres, across each edge, outside and NaN; canonical
 /// positions over `bounds` at scale 1, deterministic in `seed`.
 pub fn awkward_positions(bounds: RectI, n: usize, seed: u64) -> Vec<[f32; 2]> {
-    let mut s = seed;
-    let mut r = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut lcg = Lcg::new(seed);
+    let mut r = move || lcg.unit() as f32;
     let (x1, y1) = (bounds.x1 as f32, bounds.y1 as f32);
     let (w, h) = (bounds.width() as f32, bounds.height() as f32);
     (0..n)
