@@ -80,6 +80,9 @@ impl Stencil {
 
     /// The plate's `A` as a stencil. Interior nodes without springs take
     /// the constant biharmonic stencil; the rest are probed with unit vectors.
+    /// With [`Stencil::galerkin`], the direct definition of the levels that
+    /// [`Hierarchy::new`] builds faster from bending classes and springs
+    /// (and is tested against).
     pub fn of(plate: &Plate) -> Stencil {
         let (nx, ny) = (plate.nx, plate.ny);
         let bend = 1.0 / (plate.h * plate.h);
@@ -325,7 +328,8 @@ impl Stencil {
         Stencil::new(self.nx, self.ny, side, rows, index)
     }
 
-    /// `Pᵀ A P` on the grid of every other node (a 7 × 7 stencil).
+    /// `Pᵀ A P` on the grid of every other node (a 7 × 7 stencil), row by
+    /// row; see [`Stencil::of`].
     pub fn galerkin(&self) -> Stencil {
         use rayon::prelude::*;
         let (nx, ny) = (self.nx, self.ny);
