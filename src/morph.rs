@@ -71,21 +71,21 @@ pub fn dissolve<S: Sample, D: Sample>(
 ) {
     let dc = dst.channels;
     let (wa, wb) = ((1.0 - t) as f32, t as f32);
-    // Both sources float RGBA through maps (the usual host plates): sampled
-    // and blended pixel by pixel in one pass.
+    // Both sources float RGBA through maps (the usual host plates), both
+    // read: sampled and blended pixel by pixel in one pass.
     let direct = match (a, b) {
-        (Warped::Map(sa, ma), Warped::Map(sb, mb)) if dc == 4 => Taps::of(sa)
-            .zip(Taps::of(sb))
-            .map(|taps| (taps, (sa, ma), (sb, mb))),
+        (Warped::Map(sa, ma), Warped::Map(sb, mb)) if dc == 4 && wa != 0.0 && wb != 0.0 => {
+            Taps::of(sa)
+                .zip(Taps::of(sb))
+                .map(|(ta, tb)| [(ta, sa, ma), (tb, sb, mb)])
+        }
         _ => None,
     };
     fill_rows(dst, dc, |j, x1, row, other| {
         let warped = |src: &Warped<'_, S>, out: &mut [[f32; 4]]| src.row_as(j, x1, dc, out);
-        let spans = direct.as_ref().and_then(|(_, (_, ma), (_, mb))| {
-            map_span(ma, j, x1, row.len()).zip(map_span(mb, j, x1, row.len()))
-        });
-        if let (Some(((ta, tb), (sa, _), (sb, _))), Some((pa, pb))) = (&direct, spans) {
-            if wa != 0.0 && wb != 0.0 {
+        if let Some([(ta, sa, ma), (tb, sb, mb)]) = &direct {
+            let len = row.len();
+            if let Some((pa, pb)) = map_span(ma, j, x1, len).zip(map_span(mb, j, x1, len)) {
                 let slow = |s: &Sampler<'_, S>, p: &[[f32; 2]], n: usize| {
                     let mut v = [0f32; 4];
                     s.sample(p[n][0], p[n][1], &mut v);

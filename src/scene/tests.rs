@@ -20,6 +20,19 @@ fn err(text: &str) -> (String, String) {
     }
 }
 
+/// `text` is refused at a place starting with `at`, with a message holding `message`.
+fn assert_refused(text: &str, at: &str, message: &str) {
+    let (got_at, got_message) = err(text);
+    assert!(
+        got_at.starts_with(at),
+        "{text}: at = {got_at:?}, wanted {at:?}"
+    );
+    assert!(
+        got_message.contains(message),
+        "{text}: message = {got_message:?}, wanted {message:?}"
+    );
+}
+
 #[test]
 fn parses_the_contract_example() {
     let s = Scene::parse(GOOD).unwrap();
@@ -121,15 +134,7 @@ fn refuses_each_kind_of_bad_scene_naming_the_culprit() {
         ),
     ];
     for (text, at, message) in cases {
-        let (got_at, got_message) = err(text);
-        assert!(
-            got_at.starts_with(at),
-            "{text}: at = {got_at:?}, wanted {at:?}"
-        );
-        assert!(
-            got_message.contains(message),
-            "{text}: message = {got_message:?}, wanted {message:?}"
-        );
+        assert_refused(text, at, message);
     }
 }
 
@@ -296,16 +301,7 @@ fn bad_scattered_and_transition_settings_are_refused() {
         ),
     ];
     for (extra, at, message) in cases {
-        let text = scene(extra);
-        let (got_at, got_message) = err(&text);
-        assert!(
-            got_at.starts_with(at),
-            "{extra}: at = {got_at:?}, wanted {at:?}"
-        );
-        assert!(
-            got_message.contains(message),
-            "{extra}: message = {got_message:?}, wanted {message:?}"
-        );
+        assert_refused(&scene(extra), at, message);
     }
 }
 
@@ -368,15 +364,7 @@ fn auto_settings_are_read_and_checked() {
         ),
     ];
     for (text, at, message) in cases {
-        let (got_at, got_message) = err(text);
-        assert!(
-            got_at.starts_with(at),
-            "{text}: at = {got_at:?}, wanted {at:?}"
-        );
-        assert!(
-            got_message.contains(message),
-            "{text}: message = {got_message:?}"
-        );
+        assert_refused(text, at, message);
     }
 }
 

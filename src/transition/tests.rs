@@ -234,23 +234,13 @@ fn colour_weights_carry_t0_to_b_through_w1() {
     let scale = PixelScale::new(1.0, 1.0, 1.0);
     let eye = &fs[1];
     let mouth = Vec2::new(90.0, 60.0);
-    let map_a = crate::warp::WarpMap::new(
-        window,
-        scale,
-        vec![
-            [eye.a[0].x as f32, eye.a[0].y as f32],
-            [mouth.x as f32, mouth.y as f32],
-        ],
-    );
-    let mouth_b = fs[0].b[1];
-    let map_b = crate::warp::WarpMap::new(
-        window,
-        scale,
-        vec![
-            [eye.b[0].x as f32, eye.b[0].y as f32],
-            [mouth_b.x as f32, mouth_b.y as f32],
-        ],
-    );
+    // Two output pixels that see the given source positions.
+    let map = |p: Vec2, q: Vec2| {
+        let at = |v: Vec2| [v.x as f32, v.y as f32];
+        crate::warp::WarpMap::new(window, scale, vec![at(p), at(q)])
+    };
+    let map_a = map(eye.a[0], mouth);
+    let map_b = map(eye.b[0], fs[0].b[1]);
     let w = colour_weights(&rates, &map_a, &map_b, w1.as_ref());
     let eye_rate = 0.1;
     assert!((w.a[0] as f64 - (1.0 - eye_rate)).abs() < 2e-3, "{:?}", w.a);

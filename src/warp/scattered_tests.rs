@@ -334,16 +334,33 @@ fn energy(plate: &Plate, f: &[f64]) -> f64 {
     0.5 * e
 }
 
-fn small_plate(seed: u64, nx: usize, ny: usize) -> Plate {
+/// Twelve spring positions (grid units) and heights on an `nx × ny` grid.
+fn small_springs(seed: u64, nx: usize, ny: usize) -> (Vec<(f64, f64)>, Vec<f64>) {
     let mut r = Lcg::new(seed);
     let at: Vec<(f64, f64)> = (0..12)
         .map(|_| (r.range(0.0, (nx - 1) as f64), r.range(0.0, (ny - 1) as f64)))
         .collect();
+    let z = at.iter().map(|_| r.range(-4.0, 4.0)).collect();
+    (at, z)
+}
+
+fn small_plate(seed: u64, nx: usize, ny: usize) -> Plate {
+    let (at, z) = small_springs(seed, nx, ny);
     let mut plate = Plate::new(nx, ny, 3.0, 50.0, 1e-3, &at);
-    for s in plate.springs.iter_mut() {
-        s.z = r.range(-4.0, 4.0);
+    for (s, z) in plate.springs.iter_mut().zip(z) {
+        s.z = z;
     }
     plate
+}
+
+/// [`small_plate`]'s plate with its multigrid levels.
+fn small_hierarchy(seed: u64, nx: usize, ny: usize, levels: usize) -> Hierarchy {
+    let (at, z) = small_springs(seed, nx, ny);
+    let mut h = Hierarchy::new(nx, ny, 3.0, 50.0, 1e-3, &at, levels);
+    for (s, z) in h.plate.springs.iter_mut().zip(z) {
+        s.z = z;
+    }
+    h
 }
 
 #[test]
@@ -420,20 +437,7 @@ fn direct_solution(plate: &Plate) -> Vec<f64> {
 #[test]
 fn multigrid_matches_a_direct_solve_and_converges_per_cycle() {
     // 17 × 13 nodes: three levels down to 5 × 4 (direct there).
-    let fine = small_plate(2, 17, 13);
-    let at: Vec<(f64, f64)> = fine
-        .springs
-        .iter()
-        .map(|s| {
-            let (n, w) = (s.nodes[0], s.weights);
-            let (i, j) = ((n % 17) as f64, (n / 17) as f64);
-            (i + w[1] + w[3], j + w[2] + w[3])
-        })
-        .collect();
-    let mut h = Hierarchy::new(17, 13, fine.h, fine.alpha, fine.beta, &at, 3);
-    for (s, f) in h.plate.springs.iter_mut().zip(&fine.springs) {
-        s.z = f.z;
-    }
+    let h = small_hierarchy(2, 17, 13, 3);
     let b = h.plate.rhs();
     let mut f = vec![0.0; 17 * 13];
     let report = h.solve(&mut f, &b, 1e-10, 60);
@@ -458,10 +462,10 @@ fn multigrid_matches_a_direct_solve_and_converges_per_cycle() {
 fn a_sweep_is_gauss_seidel_node_by_node() {
     // The sweeps carry fresh values in registers and share stencils; they
     // must still be plain Gauss-Seidel, on the plate and on a Galerkin level.
-    let plate = small_plate(5, 23, 19);
-    let fine = Stencil::of(&plate);
+    let h = small_hierarchy(5, 23, 19, 2);
+    let fine = &h.levels[0];
     assert!(fine.distinct() < 23 * 19, "interior stencils are shared");
-    for stencil in [fine.clone(), fine.galerkin()] {
+    for stencil in &h.levels {
         let n = stencil.nx * stencil.ny;
         let mut r = Lcg::new(9);
         let b: Vec<f64> = (0..n).map(|_| r.range(-1.0, 1.0)).collect();

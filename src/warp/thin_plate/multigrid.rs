@@ -78,53 +78,18 @@ impl Stencil {
         }
     }
 
-    /// The plate's `A` as a stencil. Interior nodes without springs take
-    /// the constant biharmonic stencil; the rest are probed with unit vectors.
-    /// With [`Stencil::galerkin`], the direct definition of the levels that
-    /// [`Hierarchy::new`] builds faster from bending classes and springs
-    /// (and is tested against).
-    pub fn of(plate: &Plate) -> Stencil {
+    /// The plate's `A` probed node by node with unit vectors: with
+    /// [`Stencil::galerkin`], the direct definition of the levels that
+    /// [`Hierarchy::new`] builds from bending classes and springs, which
+    /// its tests hold it to.
+    #[cfg(test)]
+    pub(crate) fn of(plate: &Plate) -> Stencil {
         let (nx, ny) = (plate.nx, plate.ny);
-        let bend = 1.0 / (plate.h * plate.h);
-        let slot = |dx: i64, dy: i64| ((dy + 2) * 5 + dx + 2) as usize;
-        let mut rows = vec![0.0; 25];
-        for (dx, dy, v) in [
-            (0, 0, 20.0),
-            (1, 0, -8.0),
-            (-1, 0, -8.0),
-            (0, 1, -8.0),
-            (0, -1, -8.0),
-            (1, 1, 2.0),
-            (1, -1, 2.0),
-            (-1, 1, 2.0),
-            (-1, -1, 2.0),
-            (2, 0, 1.0),
-            (-2, 0, 1.0),
-            (0, 2, 1.0),
-            (0, -2, 1.0),
-        ] {
-            rows[slot(dx, dy)] = v * bend;
-        }
-        rows[slot(0, 0)] += plate.beta * plate.h * plate.h;
-        let mut sprung = vec![false; nx * ny];
-        for s in &plate.springs {
-            for &n in &s.nodes {
-                sprung[n] = true;
-            }
-        }
         let mut unit = vec![0.0; nx * ny];
-        let index = (0..nx * ny)
-            .map(|n| {
-                let (i, j) = (n % nx, n / nx);
-                let inside = i >= 2 && j >= 2 && i + 2 < nx && j + 2 < ny;
-                if inside && !sprung[n] {
-                    return 0;
-                }
-                rows.extend_from_slice(&probe_row(plate, &mut unit, i, j));
-                (rows.len() / 25 - 1) as u32
-            })
+        let rows = (0..nx * ny)
+            .flat_map(|n| probe_row(plate, &mut unit, n % nx, n / nx))
             .collect();
-        Stencil::new(nx, ny, 5, rows, index)
+        Stencil::new(nx, ny, 5, rows, (0..(nx * ny) as u32).collect())
     }
 
     /// The stencil of node `n` (`side²` entries).
@@ -330,43 +295,13 @@ impl Stencil {
 
     /// `Pᵀ A P` on the grid of every other node (a 7 × 7 stencil), row by
     /// row; see [`Stencil::of`].
-    pub fn galerkin(&self) -> Stencil {
-        use rayon::prelude::*;
-        let (nx, ny) = (self.nx, self.ny);
-        let (cx, cy) = ((nx - 1) / 2 + 1, (ny - 1) / 2 + 1);
-        // A coarse node whose fine nodes under P share one stencil, far
-        // enough from the edges that neither P nor the stencil is cut there,
-        // gets the product of that stencil alone: computed once per stencil.
-        let margin = 4 + self.side / 2;
-        let shared_by = |ic: usize, jc: usize| -> Option<u32> {
-            let (fx, fy) = (2 * ic, 2 * jc);
-            let inside = fx >= margin && fy >= margin && fx + margin < nx && fy + margin < ny;
-            let shared = self.index[fy * nx + fx];
-            (inside
-                && (fy - 2..=fy + 2)
-                    .all(|y| (fx - 2..=fx + 2).all(|x| self.index[y * nx + x] == shared)))
-            .then_some(shared)
-        };
-        // Which nodes need a row of their own (their position in `needed`).
-        let mut product_of: Vec<Option<u32>> = vec![None; self.distinct()];
-        let mut needed = Vec::new();
-        let index: Vec<u32> = (0..cx * cy)
-            .map(|n| {
-                let mut own = || {
-                    needed.push(n);
-                    (needed.len() - 1) as u32
-                };
-                match shared_by(n % cx, n / cx) {
-                    Some(shared) => *product_of[shared as usize].get_or_insert_with(own),
-                    None => own(),
-                }
-            })
+    #[cfg(test)]
+    pub(crate) fn galerkin(&self) -> Stencil {
+        let (cx, cy) = ((self.nx - 1) / 2 + 1, (self.ny - 1) / 2 + 1);
+        let rows = (0..cx * cy)
+            .flat_map(|n| self.galerkin_row(n % cx, n / cx, cx, cy))
             .collect();
-        let rows: Vec<f64> = needed
-            .par_iter()
-            .flat_map_iter(|&n| self.galerkin_row(n % cx, n / cx, cx, cy))
-            .collect();
-        Stencil::new(cx, cy, 7, rows, index)
+        Stencil::new(cx, cy, 7, rows, (0..(cx * cy) as u32).collect())
     }
 
     /// Row `(ic, jc)` of `Pᵀ A P` on a `cx × cy` coarse grid.
@@ -613,6 +548,9 @@ impl Block {
 
     fn new(a: &Stencil, nodes: Vec<usize>) -> Block {
         let k = nodes.len();
+        // 2 × 2 on the plate; `Pᵀ` takes a run of n nodes per axis to at
+        // most (n + 5) / 2, so a support stays within 4 × 4 on every level.
+        assert!(k <= 16, "a spring block of {k} nodes");
         let (nx, side) = (a.nx, a.side);
         let r = (side / 2) as i64;
         let mut m = vec![0.0; k * k];
