@@ -254,9 +254,12 @@ impl Stencil {
     /// rows they gather from do, or where `P` meets an end.
     fn galerkin_by_class(&self, fine: &Classes) -> (Stencil, Classes) {
         let (cx, cy) = ((self.nx - 1) / 2 + 1, (self.ny - 1) / 2 + 1);
-        // A coarse row reads fine nodes within 2 (P's reach) of its own,
-        // their stencils a further `side / 2`, and those taps' parents.
-        let margin = (fine.margin + self.side / 2 + 4).div_ceil(2);
+        // Coarse node `c` gathers the rows of fine nodes `2c − 2..=2c + 2`
+        // (P's reach), which must all be of the fine interior class, and
+        // their taps reach `side / 2` further, where none may be an end node
+        // (P is cut there): `2c − 2 ≥ fine margin` and `2c − 2 − side / 2 ≥
+        // 1`, likewise from the other end. This settles at 3.
+        let margin = (fine.margin + 2).max(self.side / 2 + 3).div_ceil(2);
         let classes = Classes::new(cx, cy, margin);
         let stencil = classes.stencil(7, |i, j| self.galerkin_row(i, j, cx, cy).to_vec());
         (stencil, classes)
@@ -543,7 +546,8 @@ impl Block {
             .collect();
         sets.sort_unstable();
         sets.dedup();
-        sets.into_iter().map(|nodes| Block::new(a, nodes)).collect()
+        use rayon::prelude::*;
+        sets.into_par_iter().map(|nodes| Block::new(a, nodes)).collect()
     }
 
     fn new(a: &Stencil, nodes: Vec<usize>) -> Block {
