@@ -547,7 +547,9 @@ impl Block {
         sets.sort_unstable();
         sets.dedup();
         use rayon::prelude::*;
-        sets.into_par_iter().map(|nodes| Block::new(a, nodes)).collect()
+        sets.into_par_iter()
+            .map(|nodes| Block::new(a, nodes))
+            .collect()
     }
 
     fn new(a: &Stencil, nodes: Vec<usize>) -> Block {
