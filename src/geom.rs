@@ -195,6 +195,11 @@ impl RectD {
         self.y2 - self.y1
     }
     /// The smallest rectangle holding this one and every point of `points`.
+    /// Whether `p` lies inside or on the border (false for NaN).
+    pub fn contains_point(&self, p: Vec2) -> bool {
+        self.x1 <= p.x && p.x <= self.x2 && self.y1 <= p.y && p.y <= self.y2
+    }
+
     pub fn including(self, points: impl IntoIterator<Item = Vec2>) -> RectD {
         points.into_iter().fold(self, |r, p| {
             RectD::new(r.x1.min(p.x), r.y1.min(p.y), r.x2.max(p.x), r.y2.max(p.y))
