@@ -164,7 +164,13 @@ fn run(cli: Cli) -> Result<(), HostError> {
             let bundle = Bundle::load(&bundle_path()?)?;
             println!("bundle: {}", bundle.binary.display());
             for p in &bundle.plugins {
-                println!("{}\t{}.{}", p.id, p.version.0, p.version.1);
+                let served_by = p
+                    .served_by
+                    .as_ref()
+                    .and_then(|b| b.file_name())
+                    .map(|b| b.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                println!("{}\t{}.{}\t{served_by}", p.id, p.version.0, p.version.1);
             }
             Ok(())
         }
@@ -504,7 +510,19 @@ impl Job {
                 .unwrap_or(e)
         };
         let (run_start, mut writing) = (Instant::now(), Duration::ZERO);
+        let transition = self.context == "OfxImageEffectContextTransition";
         for (n, &f) in frames.iter().enumerate() {
+            if transition {
+                // The host drives the context's mandated Transition param, as
+                // an editor does from where the frame sits in the transition.
+                let t =
+                    c.t.or_else(|| scene.as_ref().and_then(|s| s.progress_at(f as f64)));
+                let t = t.unwrap_or_else(|| match frames.len() {
+                    1 => 0.5,
+                    k => n as f64 / (k - 1) as f64,
+                });
+                inst.set_double("Transition", &[t], None)?;
+            }
             for (view, pattern) in &outputs {
                 inst.set_choice("view", view)?;
                 let out = inst

@@ -225,6 +225,8 @@ fn render_morph(case: &Case) -> (Image, Image, Image) {
         top_down: case.top_down,
         render_scale: (case.scale, case.scale),
         tiles: case.tiles,
+        // The plugin's own pixels, compared with the core's.
+        identity: false,
     };
     inst.begin_sequence(1.0, 1.0).unwrap();
     let out = inst.render(1.0, spec).unwrap();

@@ -43,25 +43,67 @@ fn cargo(args: &[&str]) {
     }
 }
 
-/// Builds the cdylib and lays out `target/bundle/MorphFX.ofx.bundle`.
-fn bundle(release: bool) -> PathBuf {
-    let profile = if release { "release" } else { "debug" };
-    let mut args = vec!["build", "--package", "morphfx-ofx"];
-    if release {
-        args.push("--release");
-    }
-    cargo(&args);
-    let target = std::env::var("CARGO_TARGET_DIR")
+fn target_dir() -> PathBuf {
+    std::env::var("CARGO_TARGET_DIR")
         .map(PathBuf::from)
-        .unwrap_or_else(|_| root().join("target"));
-    let bundle = target.join("bundle").join("MorphFX.ofx.bundle");
-    let bin_dir = bundle.join("Contents").join("Linux-x86-64");
-    std::fs::create_dir_all(&bin_dir).expect("create bundle folders");
-    std::fs::copy(
-        target.join(profile).join("libmorphfx_ofx.so"),
-        bin_dir.join("MorphFX.ofx"),
-    )
-    .expect("copy the plugin binary");
+        .unwrap_or_else(|_| root().join("target"))
+}
+
+/// `cargo build --package morphfx-ofx`, for baseline x86-64 or, with
+/// `fast`, for x86-64-v3 in its own target folder (other RUSTFLAGS would
+/// otherwise rebuild the baseline's artefacts each time). Returns the `.so`.
+fn build_plugin(release: bool, fast: bool) -> PathBuf {
+    let profile = if release { "release" } else { "debug" };
+    let cargo_bin = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let mut c = Command::new(cargo_bin);
+    c.args(["build", "--package", "morphfx-ofx"])
+        .current_dir(root());
+    if release {
+        c.arg("--release");
+    }
+    let mut dir = target_dir();
+    if fast {
+        dir = dir.join("x86-64-v3");
+        let flags = std::env::var("RUSTFLAGS").unwrap_or_default();
+        c.env("RUSTFLAGS", format!("{flags} -C target-cpu=x86-64-v3"))
+            .arg("--target-dir")
+            .arg(&dir);
+    }
+    let status = c.status().expect("cargo runs");
+    if !status.success() {
+        exit(status.code().unwrap_or(1));
+    }
+    dir.join(profile).join("libmorphfx_ofx.so")
+}
+
+/// The OFX architecture folders a build for this machine goes into. The
+/// reference host (and hosts built on it) scans `Linux-x86-64` on every
+/// 64-bit Linux, ARM included, so ARM builds go there as well as into
+/// `Linux-arm-64`.
+fn arch_folders() -> &'static [&'static str] {
+    if cfg!(target_arch = "aarch64") {
+        &["Linux-arm-64", "Linux-x86-64"]
+    } else {
+        &["Linux-x86-64"]
+    }
+}
+
+/// Builds the plugin and lays out `target/bundle/MorphFX.ofx.bundle`: the
+/// baseline build as `MorphFX.ofx` and, on x86-64, the x86-64-v3 build beside
+/// it, which the baseline build hands over to on CPUs with AVX2 and FMA.
+fn bundle(release: bool) -> PathBuf {
+    let baseline = build_plugin(release, false);
+    let fast = cfg!(target_arch = "x86_64").then(|| build_plugin(release, true));
+    let bundle = target_dir().join("bundle").join("MorphFX.ofx.bundle");
+    for arch in arch_folders() {
+        let bin_dir = bundle.join("Contents").join(arch);
+        std::fs::create_dir_all(&bin_dir).expect("create bundle folders");
+        std::fs::copy(&baseline, bin_dir.join("MorphFX.ofx")).expect("copy the plugin binary");
+        if let Some(fast) = &fast {
+            std::fs::copy(fast, bin_dir.join("MorphFX-x86-64-v3.so"))
+                .expect("copy the x86-64-v3 plugin binary");
+        }
+    }
     let plist =
         std::fs::read_to_string(root().join("bundle/Info.plist")).expect("bundle/Info.plist");
     std::fs::write(bundle.join("Contents").join("Info.plist"), plist).expect("write Info.plist");

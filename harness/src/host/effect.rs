@@ -53,6 +53,9 @@ pub struct Effect {
     pub timeline: Mutex<(f64, f64, f64)>,
     /// Progress the plugin last reported (progress suite), if a task is open.
     pub progress: Mutex<Option<(String, f64)>>,
+    /// The persistent message the plugin set (message suite v2), until it
+    /// clears it: what a host shows on the node (Natron draws it red).
+    pub persistent: Mutex<Option<Message>>,
 }
 
 static LIVE_EFFECTS: Mutex<Option<HashSet<usize>>> = Mutex::new(None);
@@ -67,6 +70,7 @@ impl Effect {
             render_scale: Mutex::new((1.0, 1.0)),
             timeline: Mutex::new((0.0, 0.0, 0.0)),
             progress: Mutex::new(None),
+            persistent: Mutex::new(None),
         });
         LIVE_EFFECTS
             .lock()
@@ -431,7 +435,51 @@ pub unsafe extern "C" fn mfx_message_text(
     kOfxStatOK
 }
 
+/// # Safety
+/// Called by the C shim with the plugin's handle (checked against live effects) and C strings.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mfx_persistent_text(
+    handle: *mut c_void,
+    kind: *const c_char,
+    id: *const c_char,
+    text: *const c_char,
+) -> c_int {
+    let s = |p: *const c_char| {
+        if p.is_null() {
+            String::new()
+        } else {
+            // SAFETY: NUL-terminated strings from the plugin or the shim's buffer.
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+        }
+    };
+    // The spec: the handle may NOT be null, and must be an instance.
+    let Some(e) = live_effect(handle) else {
+        return kOfxStatErrBadHandle;
+    };
+    *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = Some(Message {
+        kind: s(kind),
+        id: s(id),
+        text: s(text),
+    });
+    kOfxStatOK
+}
+
+unsafe extern "C" fn clear_persistent(handle: *mut c_void) -> OfxStatus {
+    let Some(e) = live_effect(handle) else {
+        return kOfxStatErrBadHandle;
+    };
+    *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    kOfxStatOK
+}
+
 unsafe extern "C" {
+    fn mfx_persistent_message(
+        handle: *mut c_void,
+        kind: *const c_char,
+        id: *const c_char,
+        format: *const c_char,
+        ...
+    ) -> OfxStatus;
     fn mfx_message(
         handle: *mut c_void,
         kind: *const c_char,
@@ -443,4 +491,11 @@ unsafe extern "C" {
 
 pub static MESSAGE_SUITE: OfxMessageSuiteV1 = OfxMessageSuiteV1 {
     message: Some(mfx_message),
+};
+
+/// Version 2 extends version 1 in place, as the spec allows a host to answer both.
+pub static MESSAGE_SUITE_V2: OfxMessageSuiteV2 = OfxMessageSuiteV2 {
+    message: Some(mfx_message),
+    setPersistentMessage: Some(mfx_persistent_message),
+    clearPersistentMessage: Some(clear_persistent),
 };

@@ -215,3 +215,25 @@ fn flip_rows(data: &[f32], row: usize) -> Vec<f32> {
     }
     data.chunks(row).rev().flatten().copied().collect()
 }
+
+/// `img` with `channels` components, as a host converts between clips:
+/// RGBA to RGB drops alpha, RGB to RGBA adds an opaque one, Alpha keeps the
+/// alpha (or the luminance-free opacity 1 of an RGB image).
+pub fn with_channels(img: &Image, channels: usize) -> Image {
+    if img.channels == channels {
+        return img.clone();
+    }
+    let n = img.channels;
+    Image::from_fn(img.bounds, channels, |i, j, c| {
+        let p = img.pixel(i, j);
+        match (n, channels) {
+            (4, 1) => p[3],
+            (3, 1) => 1.0,
+            (1, _) if c == 3 => p[0],
+            (1, _) => 0.0,
+            (_, _) if c < 3 => p[c.min(n - 1)],
+            (4, _) => p[3],
+            _ => 1.0,
+        }
+    })
+}

@@ -10,7 +10,7 @@ pub mod services;
 
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use morphfx::geom::RectI;
 use openfx::sys::generic::core::*;
@@ -67,8 +67,29 @@ impl std::fmt::Display for HostError {
 }
 impl std::error::Error for HostError {}
 
+/// Host structs (by their property set) whose plugins have been sent the
+/// load action: before it, the spec lets a plugin fetch no suite.
+static LOADED_HOSTS: Mutex<Vec<usize>> = Mutex::new(Vec::new());
+
+/// What this host saw a plugin do against the spec, for tests to fail on.
+static VIOLATIONS: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// Records a spec violation by the plugin (and says it on stderr).
+pub fn violation(what: String) {
+    eprintln!("morphfx: the plugin broke the OpenFX spec: {what}");
+    VIOLATIONS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(what);
+}
+
+/// The spec violations seen so far in this process (taken).
+pub fn take_violations() -> Vec<String> {
+    std::mem::take(&mut *VIOLATIONS.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
 unsafe extern "C" fn fetch_suite(
-    _host: OfxPropertySetHandle,
+    host: OfxPropertySetHandle,
     name: *const c_char,
     version: c_int,
 ) -> *const c_void {
@@ -77,11 +98,23 @@ unsafe extern "C" fn fetch_suite(
     }
     // SAFETY: suite names are NUL-terminated C strings.
     let name = unsafe { CStr::from_ptr(name) };
+    let loaded = LOADED_HOSTS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .contains(&(host as usize));
+    if !loaded {
+        violation(format!(
+            "fetchSuite({}, {version}) before the load action",
+            name.to_string_lossy()
+        ));
+        return std::ptr::null();
+    }
     match (name, version) {
         (n, 1) if n == kOfxPropertySuite => &props::SUITE as *const _ as *const c_void,
         (n, 1) if n == kOfxImageEffectSuite => &effect::SUITE as *const _ as *const c_void,
         (n, 1) if n == kOfxParameterSuite => &params::SUITE as *const _ as *const c_void,
         (n, 1) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE as *const _ as *const c_void,
+        (n, 2) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE_V2 as *const _ as *const c_void,
         (n, 1) if n == kOfxMemorySuite => &services::MEMORY_SUITE as *const _ as *const c_void,
         (n, 1) if n == kOfxMultiThreadSuite => {
             &services::MULTI_THREAD_SUITE as *const _ as *const c_void
@@ -102,13 +135,35 @@ unsafe extern "C" fn fetch_suite(
 pub struct PluginInfo {
     pub id: String,
     pub version: (u32, u32),
+    /// The binary whose code answers this plugin's actions (a bundle may hand
+    /// over to another build of itself, e.g. one for the CPU it runs on).
+    pub served_by: Option<PathBuf>,
     plugin: *const OfxPlugin,
+}
+
+/// The shared object that holds `address`, from the dynamic loader.
+fn object_holding(address: *const c_void) -> Option<PathBuf> {
+    let mut info = libc::Dl_info {
+        dli_fname: std::ptr::null(),
+        dli_fbase: std::ptr::null_mut(),
+        dli_sname: std::ptr::null(),
+        dli_saddr: std::ptr::null_mut(),
+    };
+    // SAFETY: dladdr only reads the loader's tables; `info` is a live local.
+    if unsafe { libc::dladdr(address, &mut info) } == 0 || info.dli_fname.is_null() {
+        return None;
+    }
+    // SAFETY: dli_fname is a NUL-terminated path owned by the loader.
+    let name = unsafe { CStr::from_ptr(info.dli_fname) };
+    Some(PathBuf::from(name.to_string_lossy().into_owned()))
 }
 
 /// A loaded bundle and its plugins.
 pub struct Bundle {
     pub binary: PathBuf,
     pub plugins: Vec<PluginInfo>,
+    /// Plugins sent the load action (once each; unload when the bundle goes).
+    loaded: Mutex<Vec<usize>>,
     host: Box<OfxHost>,
     _host_props: Box<PropertySet>,
     _lib: libloading::Library,
@@ -210,6 +265,9 @@ impl Bundle {
                     set_host(&*host as *const OfxHost as *mut OfxHost);
                 }
                 plugins.push(PluginInfo {
+                    served_by: plugin
+                        .mainEntry
+                        .and_then(|f| object_holding(f as *const c_void)),
                     id: CStr::from_ptr(plugin.pluginIdentifier)
                         .to_string_lossy()
                         .into_owned(),
@@ -222,6 +280,7 @@ impl Bundle {
         Ok(Bundle {
             binary,
             plugins,
+            loaded: Mutex::new(Vec::new()),
             host,
             _host_props: host_props,
             _lib: lib,
@@ -263,11 +322,7 @@ impl Bundle {
                 Err(failure(st, what, effect))
             }
         };
-        check(
-            self.call(plugin, kOfxActionLoad, std::ptr::null(), None, None),
-            "load",
-            None,
-        )?;
+        self.send_load(plugin)?;
         let descriptor = Effect::new();
         descriptor
             .props
@@ -358,10 +413,59 @@ impl Bundle {
     pub fn host(&self) -> &OfxHost {
         &self.host
     }
+
+    /// Sends the load action to `plugin` once (the spec: before describe,
+    /// and never twice without an unload). Suites may be fetched from then on.
+    fn send_load(&self, plugin: *const OfxPlugin) -> Result<(), HostError> {
+        let mut loaded = self.loaded.lock().unwrap_or_else(|e| e.into_inner());
+        if loaded.contains(&(plugin as usize)) {
+            return Ok(());
+        }
+        LOADED_HOSTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(self.host.host as usize);
+        let st = self.call(plugin, kOfxActionLoad, std::ptr::null(), None, None);
+        if st != kOfxStatOK && st != kOfxStatReplyDefault {
+            return Err(HostError::failed(format!(
+                "the plugin failed its load action (OFX status {st})"
+            )));
+        }
+        loaded.push(plugin as usize);
+        Ok(())
+    }
+}
+
+impl Drop for Bundle {
+    fn drop(&mut self) {
+        let loaded = std::mem::take(&mut *self.loaded.lock().unwrap_or_else(|e| e.into_inner()));
+        for plugin in loaded {
+            let _ = self.call(
+                plugin as *const OfxPlugin,
+                kOfxActionUnload,
+                std::ptr::null(),
+                None,
+                None,
+            );
+        }
+        LOADED_HOSTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .retain(|h| *h != self.host.host as usize);
+    }
 }
 
 fn failure(status: OfxStatus, what: &str, effect: Option<&Effect>) -> HostError {
-    let messages = effect.map(|e| e.take_messages()).unwrap_or_default();
+    let mut messages = effect.map(|e| e.take_messages()).unwrap_or_default();
+    // Render-time errors arrive as the persistent message (message suite v2).
+    if let Some(m) = effect.and_then(|e| {
+        e.persistent
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }) {
+        messages.push(m);
+    }
     let errors: Vec<&Message> = messages
         .iter()
         .filter(|m| m.kind == kOfxMessageError.to_string_lossy())
@@ -392,6 +496,9 @@ pub struct OutputSpec {
     pub render_scale: (f64, f64),
     /// Split the window into this many bands rendered concurrently.
     pub tiles: usize,
+    /// Ask isIdentity first and copy the source it names, as hosts do
+    /// (off: always render, to compare the plugin's own pixels).
+    pub identity: bool,
 }
 
 impl Default for OutputSpec {
@@ -402,6 +509,7 @@ impl Default for OutputSpec {
             top_down: false,
             render_scale: (1.0, 1.0),
             tiles: 1,
+            identity: true,
         }
     }
 }
@@ -412,6 +520,11 @@ impl Instance<'_> {
             .params
             .get(name)
             .ok_or_else(|| HostError::bad(format!("the plugin has no param {name}")))
+    }
+
+    /// The plugin's descriptor properties (what describe set).
+    pub fn descriptor_props(&self) -> &PropertySet {
+        &self._descriptor.props
     }
 
     pub fn param_names(&self) -> Vec<(String, String)> {
@@ -512,15 +625,21 @@ impl Instance<'_> {
     }
 
     pub fn set_project(&self, width: f64, height: f64) {
-        for k in [
-            kOfxImageEffectPropProjectSize,
-            kOfxImageEffectPropProjectExtent,
-        ] {
-            self.effect.props.set_double(k, &[width, height]);
-        }
-        self.effect
-            .props
-            .set_double(kOfxImageEffectPropProjectOffset, &[0.0, 0.0]);
+        self.set_letterboxed_project((width, height), (0.0, 0.0), (width, height));
+    }
+
+    /// A project whose images fill `size` at `offset` inside an `extent`
+    /// rooted at 0,0 (a letterboxed format: the spec's project properties).
+    pub fn set_letterboxed_project(
+        &self,
+        extent: (f64, f64),
+        offset: (f64, f64),
+        size: (f64, f64),
+    ) {
+        let p = &self.effect.props;
+        p.set_double(kOfxImageEffectPropProjectExtent, &[extent.0, extent.1]);
+        p.set_double(kOfxImageEffectPropProjectOffset, &[offset.0, offset.1]);
+        p.set_double(kOfxImageEffectPropProjectSize, &[size.0, size.1]);
     }
 
     fn act(
@@ -592,7 +711,45 @@ impl Instance<'_> {
         ))
     }
 
-    /// Renders the frame at `time` into a new buffer laid out as `spec`.
+    /// Asks the plugin whether the output at `time` is one of its sources
+    /// unchanged (`kOfxImageEffectActionIsIdentity`), as hosts do before
+    /// rendering: `Some((clip, time))` when it is.
+    pub fn identity(
+        &self,
+        time: f64,
+        window: RectI,
+        scale: (f64, f64),
+    ) -> Result<Option<(String, f64)>, HostError> {
+        let a = PropertySet::new();
+        a.set_double(kOfxPropTime, &[time]);
+        a.set_str(kOfxImageEffectPropFieldToRender, "OfxImageFieldNone");
+        a.set_int(
+            kOfxImageEffectPropRenderWindow,
+            &[window.x1, window.y1, window.x2, window.y2],
+        );
+        a.set_double(kOfxImageEffectPropRenderScale, &[scale.0, scale.1]);
+        let out = PropertySet::new();
+        out.set_str(kOfxPropName, "");
+        out.set_double(kOfxPropTime, &[time]);
+        if self.act(kOfxImageEffectActionIsIdentity, Some(&a), Some(&out))? != kOfxStatOK {
+            return Ok(None);
+        }
+        let name = out
+            .strs(kOfxPropName)
+            .into_iter()
+            .next()
+            .unwrap_or_default();
+        let at = out.doubles(kOfxPropTime).first().copied().unwrap_or(time);
+        if self.effect.clip(&name).is_none() || name == "Output" {
+            return Err(HostError::failed(format!(
+                "isIdentity named clip \"{name}\", which is not one of the plugin's source clips"
+            )));
+        }
+        Ok(Some((name, at)))
+    }
+
+    /// Renders the frame at `time` into a new buffer laid out as `spec`,
+    /// or copies the source the plugin names as identical.
     pub fn render(&self, time: f64, spec: OutputSpec) -> Result<Arc<Frame>, HostError> {
         self.effect.take_messages();
         self.effect
@@ -613,6 +770,23 @@ impl Instance<'_> {
             (rod.x2 as f64 * sx).ceil() as i32,
             (rod.y2 as f64 * sy).ceil() as i32,
         );
+        if spec.identity {
+            if let Some((clip, at)) = self.identity(time, bounds, spec.render_scale)? {
+                let source = self
+                    .effect
+                    .clip(&clip)
+                    .and_then(|c| c.frame_at(at).ok().flatten());
+                let image = match source {
+                    Some(f) => frame::with_channels(&f.to_image(), spec.channels),
+                    None => morphfx::image::Image::new(bounds, spec.channels),
+                };
+                return Ok(Arc::new(Frame::from_image(
+                    &image,
+                    spec.depth,
+                    spec.top_down,
+                )));
+            }
+        }
         let out = Arc::new(Frame::blank(
             bounds,
             spec.channels,

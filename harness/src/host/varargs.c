@@ -12,6 +12,7 @@ extern int mfx_param_shape(void *param, int *kind, int *dim);
 extern int mfx_param_get(void *param, double time, int at_time, double *d, int *iv, const char **s);
 extern int mfx_param_set(void *param, double time, int at_time, const double *d, const int *iv, const char *s);
 extern int mfx_message_text(void *handle, const char *type, const char *id, const char *text);
+extern int mfx_persistent_text(void *handle, const char *type, const char *id, const char *text);
 
 static OfxStatus get_va(void *h, double time, int at_time, va_list ap) {
     int kind = 0, dim = 0, k;
@@ -75,4 +76,12 @@ OfxStatus mfx_message(void *handle, const char *type, const char *id, const char
     vsnprintf(buf, sizeof buf, format ? format : "", ap);
     va_end(ap);
     return mfx_message_text(handle, type, id, buf);
+}
+
+OfxStatus mfx_persistent_message(void *handle, const char *type, const char *id, const char *format, ...) {
+    char buf[4096];
+    va_list ap; va_start(ap, format);
+    vsnprintf(buf, sizeof buf, format ? format : "", ap);
+    va_end(ap);
+    return mfx_persistent_text(handle, type, id, buf);
 }

@@ -1,6 +1,7 @@
 //! Per-instance state: the warp cache, the parsed scene, messages said once.
 
 use std::collections::HashSet;
+use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 use morphfx::image::Plane;
@@ -15,6 +16,9 @@ use crate::wrapper::{dispatch, Outcome};
 
 #[derive(Default)]
 pub struct Instance {
+    /// A render failure's persistent message is on the node (cleared by the
+    /// next good render).
+    pub error_shown: AtomicBool,
     pub warps: WarpCache,
     /// The last scene parsed, keyed by where it came from (text, or path + mtime + size).
     pub scene: Mutex<Option<(String, Arc<Scene>)>>,

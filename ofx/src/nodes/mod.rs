@@ -69,7 +69,7 @@ pub fn action(
     in_args: OfxPropertySetHandle,
     out_args: OfxPropertySetHandle,
 ) -> Outcome<OfxStatus> {
-    if is(action, kOfxActionLoad) || is(action, kOfxActionUnload) {
+    if is(action, kOfxActionUnload) {
         return Ok(kOfxStatOK);
     }
     let effect = effect.ok_or_else(|| {
@@ -97,8 +97,11 @@ pub fn action(
         render::regions_of_interest(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionGetFramesNeeded) {
         render::frames_needed(kind, &effect, &in_props()?, &out_props()?)?;
+    } else if is(action, kOfxImageEffectActionIsIdentity) {
+        return render::is_identity(kind, &effect, &in_props()?, &out_props()?);
     } else if is(action, kOfxImageEffectActionRender) {
         render::render(kind, &effect, &in_props()?)?;
+        crate::wrapper::dispatch::render_succeeded(&effect);
     } else if is(action, kOfxActionInstanceChanged) {
         snap::instance_changed(kind, &effect, &in_props()?)?;
     } else {
@@ -141,7 +144,11 @@ fn describe(kind: NodeKind, effect: &Effect) -> Outcome {
     let _ = p.set_int(kOfxImageEffectPropTemporalClipAccess, 0, 1);
     let _ = p.set_int(kOfxImageEffectPropSupportsMultipleClipDepths, 0, 0);
     let _ = p.set_int(kOfxImageEffectPropSupportsMultipleClipPARs, 0, 0);
-    let _ = p.set_int(kOfxImageEffectPluginPropFieldRenderTwiceAlways, 0, 0);
+    // A geometric warp must not mix the two fields of interlaced footage,
+    // so FieldRenderTwiceAlways keeps its default (1: render each field).
+    // Warm starts make a sequence cheaper in frame order, but any order is
+    // correct (they are only used when the host says it renders in order).
+    let _ = p.set_int(kOfxImageEffectInstancePropSequentialRender, 0, 2);
     Ok(())
 }
 
@@ -171,5 +178,17 @@ fn describe_in_context(kind: NodeKind, effect: &Effect, context: &str) -> Outcom
         ],
     )?;
     let _ = out.set_int(kOfxImageEffectPropSupportsTiles, 0, 1);
-    host_params::define_all(effect.param_set()?, &params::table(kind))
+    let mut table = params::table(kind);
+    if context == render::TRANSITION {
+        // Mandated in this context (Parameters Mandated In A Context): the
+        // plugin defines it, the host drives it.
+        let name = kOfxImageEffectTransitionParamName.to_string_lossy();
+        table.push(spec::ParamSpec::new(
+            name,
+            "",
+            "",
+            spec::Kind::HostDriven { default: 0.0 },
+        ));
+    }
+    host_params::define_all(effect.param_set()?, &table)
 }

@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 use morphfx::features::{Feature, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::resample::through;
-use morphfx::image::{ImageView, Plane, RowsMut, Sample, Sampler};
+use morphfx::image::{EdgeMode, ImageView, Layout, Plane, RowsMut, Sample, Sampler};
 use morphfx::morph::{dissolve, dissolve_weighted, show, Warped};
 use morphfx::scene::{Method, Scene};
 use morphfx::transition::{self, Rates, Weights};
@@ -25,7 +25,7 @@ use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT, PLATES_KEPT};
 use super::params::{Settings, OFFSET_A, OFFSET_B};
 use super::NodeKind;
 use crate::cache::key_of;
-use crate::wrapper::clips::{Clip, Depth, Effect, HostImage};
+use crate::wrapper::clips::{Clip, Depth, Effect, HostImage, ImageInfo};
 use crate::wrapper::props::PropSet;
 use crate::wrapper::{Failure, Outcome};
 
@@ -49,7 +49,7 @@ macro_rules! with_depth {
     };
 }
 
-const TRANSITION: &str = "OfxImageEffectContextTransition";
+pub(super) const TRANSITION: &str = "OfxImageEffectContextTransition";
 
 pub(super) fn context(effect: &Effect) -> String {
     effect
@@ -72,19 +72,27 @@ fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
     (a, b)
 }
 
-/// The clip whose frame the output takes: A, else B when only B is connected.
-fn format_clip(kind: NodeKind, effect: &Effect, context: &str) -> Outcome<(Clip, f64)> {
+/// The clip whose frame the output takes, and the time it is read at: A at
+/// its offset, else B at its offset when only B is connected. The region of
+/// definition, the identity answer and the render all use this one answer.
+fn format_source(
+    kind: NodeKind,
+    effect: &Effect,
+    context: &str,
+    time: f64,
+) -> Outcome<(Clip, f64)> {
     let (a, b) = kind.source_clips(context);
+    let (oa, ob) = offsets(kind, effect, time);
     let clip_a = effect.clip(a)?;
     if !clip_a.is_connected() {
         if let Some(b) = b {
             let clip_b = effect.clip(b)?;
             if clip_b.is_connected() {
-                return Ok((clip_b, 1.0));
+                return Ok((clip_b, time + ob));
             }
         }
     }
-    Ok((clip_a, 0.0))
+    Ok((clip_a, time + oa))
 }
 
 pub fn region_of_definition(
@@ -94,10 +102,8 @@ pub fn region_of_definition(
     out_args: &PropSet,
 ) -> Outcome {
     let time = in_args.get_double(kOfxPropTime, 0)?;
-    let context = context(effect);
-    let (clip, which) = format_clip(kind, effect, &context)?;
-    let (oa, ob) = offsets(kind, effect, time);
-    let rod = clip.rod(time + if which == 0.0 { oa } else { ob })?;
+    let (clip, source_time) = format_source(kind, effect, &context(effect), time)?;
+    let rod = clip.rod(source_time)?;
     out_args.set_doubles(
         kOfxImageEffectPropRegionOfDefinition,
         &[rod.x1, rod.y1, rod.x2, rod.y2],
@@ -146,6 +152,56 @@ pub fn frames_needed(
         out_args.set_doubles(&prop, &[time + off, time + off])?;
     }
     Ok(())
+}
+
+/// The source a node's output equals bit for bit at this time, if any:
+/// progress 0 shows A and 1 shows B unchanged (through the views that pass a
+/// picture through), unless a transition paces pixels differently. Answered
+/// `kOfxStatOK` with the clip and its time, else `kOfxStatReplyDefault`.
+pub fn is_identity(
+    kind: NodeKind,
+    effect: &Effect,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome<OfxStatus> {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let instance = instance::get(effect)?;
+    let context = context(effect);
+    let settings = Settings::read(&effect.params()?, time, kind);
+    let frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
+    let Some(side) = identity_side(kind, settings.view, &frame) else {
+        return Ok(kOfxStatReplyDefault);
+    };
+    let (a, b) = kind.source_clips(&context);
+    let (name, offset) = match (side, b) {
+        (Side::B, Some(b)) => (b, settings.offset_b),
+        _ => (a, settings.offset_a),
+    };
+    if !effect.clip(name)?.is_connected() {
+        return Ok(kOfxStatReplyDefault); // rendered as transparent black
+    }
+    out_args.set_string(kOfxPropName, 0, name)?;
+    out_args.set_double(kOfxPropTime, 0, time + offset as f64)?;
+    Ok(kOfxStatOK)
+}
+
+/// Which source the output is at `frame`'s progress, when it is one unchanged.
+fn identity_side(kind: NodeKind, view: View, frame: &Frame) -> Option<Side> {
+    let transition = &frame.warp.transition;
+    if !(transition.geometry.is_uniform_at(frame.t) && transition.colour().is_uniform_at(frame.t)) {
+        return None;
+    }
+    let side = if frame.t <= 0.0 {
+        Side::A
+    } else if frame.t >= 1.0 && kind == NodeKind::Morph {
+        Side::B
+    } else {
+        return None;
+    };
+    match (view, side) {
+        (View::Morph, _) | (View::WarpedA, Side::A) | (View::WarpedB, Side::B) => Some(side),
+        _ => None,
+    }
 }
 
 /// The scene named by the params, parsed once per content.
@@ -243,20 +299,78 @@ fn frame_at(
     Ok(Frame { features, warp, t })
 }
 
-fn source(effect: &Effect, name: &str, time: f64) -> Outcome<HostImage> {
+/// A source clip's image, or `None` where the host has none: an unconnected
+/// clip, or a fetch that failed, which the spec says to treat as transparent
+/// black and carry on.
+fn source(effect: &Effect, name: &str, time: f64) -> Outcome<Option<(HostImage, ImageInfo)>> {
     let clip = effect.clip(name)?;
     if !clip.is_connected() {
-        return Err(Failure::BadInput(format!("clip {name} is not connected")));
+        return Ok(None);
     }
-    clip.image(time)?
-        .ok_or_else(|| Failure::BadInput(format!("clip {name} has no image at frame {time}")))
+    match clip.image(time)? {
+        Some(image) => {
+            let info = image.info()?;
+            Ok(Some((image, info)))
+        }
+        None => Ok(None),
+    }
 }
 
-pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
+/// The largest frame (canonical px along a side) a warp covers; a larger or
+/// infinite region of definition (allowed by the spec) is cut to the project.
+const LARGEST_FRAME: f64 = 65536.0;
+
+/// The canonical frame a warp covers: the format source's region of
+/// definition, or, where that is infinite or absurdly large, the project.
+fn warp_frame(effect: &Effect, rod: &OfxRectD) -> RectD {
+    let r = RectD::new(rod.x1, rod.y1, rod.x2, rod.y2);
+    if r.width() <= LARGEST_FRAME && r.height() <= LARGEST_FRAME && r.is_valid() {
+        return r;
+    }
+    let (origin, size) = project(effect, rod);
+    let p = RectD::new(origin.x, origin.y, origin.x + size.x, origin.y + size.y);
+    let cut = RectD::new(
+        r.x1.max(p.x1),
+        r.y1.max(p.y1),
+        r.x2.min(p.x2),
+        r.y2.min(p.y2),
+    );
+    if cut.is_valid() && cut.width() > 0.0 && cut.height() > 0.0 {
+        cut
+    } else {
+        p
+    }
+}
+
+/// What one render call reads from the host, before any computing.
+struct Gathered {
+    time: f64,
+    window: RectI,
+    /// The host renders frames in order on this instance (warm starts allowed).
+    sequential: bool,
+    settings: Settings,
+    frame: Frame,
+    a: Option<(HostImage, ImageInfo)>,
+    b: Option<(HostImage, ImageInfo)>,
+    out_info: ImageInfo,
+    /// The format source's region of definition at its time.
+    rod: OfxRectD,
+    project: (Vec2, Vec2),
+}
+
+/// What one render call reads from the host, and the output image to write.
+fn gather(
+    kind: NodeKind,
+    effect: &Effect,
+    instance: &Instance,
+    in_args: &PropSet,
+) -> Outcome<(Gathered, HostImage)> {
     let time = in_args.get_double(kOfxPropTime, 0)?;
     let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
-    let window = RectI::new(x1, y1, x2, y2);
-    let instance = instance::get(effect)?;
+    let sequential = in_args
+        .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
+        .unwrap_or(0)
+        == 1;
     let context = context(effect);
     let settings = Settings::read(&effect.params()?, time, kind);
     if !settings.missing.is_empty() && instance.first_time("missing params") {
@@ -269,59 +383,135 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
             ),
         );
     }
-    let mut frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
-
+    let frame = frame_at(kind, effect, instance, &settings, time, &context)?;
     let (a_name, b_name) = kind.source_clips(&context);
-    let a_img = source(effect, a_name, time + settings.offset_a as f64)?;
-    let b_img = match b_name {
-        Some(b) => Some(source(effect, b, time + settings.offset_b as f64)?),
+    let a = source(effect, a_name, time + settings.offset_a as f64)?;
+    let b = match b_name {
+        Some(b) => source(effect, b, time + settings.offset_b as f64)?,
         None => None,
     };
-    let mut out_img = effect
+    let out = effect
         .clip("Output")?
         .image(time)?
         .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
-    let out_info = out_img.info()?;
-    let a_info = a_img.info()?;
-    let b_info = b_img.as_ref().map(|b| b.info()).transpose()?;
+    let out_info = out.info()?;
+    let (format_clip, format_time) = format_source(kind, effect, &context, time)?;
+    let rod = format_clip.rod(format_time)?;
+    let project = project(effect, &rod);
+    let gathered = Gathered {
+        time,
+        window: RectI::new(x1, y1, x2, y2),
+        sequential,
+        settings,
+        frame,
+        a,
+        b,
+        out_info,
+        rod,
+        project,
+    };
+    Ok((gathered, out))
+}
 
-    let a_scale = PixelScale::new(a_info.render_scale.0, a_info.render_scale.1, a_info.par);
-    let b_scale = b_info.map(|b| PixelScale::new(b.render_scale.0, b.render_scale.1, b.par));
-    if frame.warp.method == Method::Auto {
-        let (Some(b_img), Some(b_info), Some(b_scale)) = (&b_img, &b_info, b_scale) else {
-            return Err(Failure::BadInput(
-                "method \"auto\" finds its warp from two images: use the Morph node (this node has one source)".into(),
-            ));
-        };
-        if b_info.depth != a_info.depth {
+/// Transparent black, standing in for a source the host has no image of.
+const BLACK: [f32; 4] = [0.0; 4];
+
+/// A view over `source`'s pixels, or over one transparent black pixel.
+fn view_of<'a, S: Sample>(
+    source: &'a Option<(HostImage, ImageInfo)>,
+    black: &'a [S; 4],
+) -> Outcome<ImageView<'a, S>> {
+    match source {
+        Some((image, info)) => image.view::<S>(info),
+        None => {
+            ImageView::new(black, Layout::packed(RectI::new(0, 0, 1, 1), 4)).map_err(Failure::from)
+        }
+    }
+}
+
+pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
+    let instance = instance::get(effect)?;
+    let (mut g, mut out) = gather(kind, effect, &instance, in_args)?;
+    let out_scale = PixelScale::new(
+        g.out_info.render_scale.0,
+        g.out_info.render_scale.1,
+        g.out_info.par,
+    );
+    let scale_of = |s: &Option<(HostImage, ImageInfo)>| match s {
+        Some((_, i)) => PixelScale::new(i.render_scale.0, i.render_scale.1, i.par),
+        None => out_scale,
+    };
+    let (a_scale, b_scale) = (scale_of(&g.a), scale_of(&g.b));
+    // Both sources are read at one depth (the descriptor says so); a missing
+    // one takes the other's, or the output's.
+    let depth = match (&g.a, &g.b) {
+        (Some((_, a)), Some((_, b))) if a.depth != b.depth => {
             return Err(Failure::BadInput(
                 "Source A and Source B have different bit depths".into(),
-            ));
+            ))
         }
-        let (a_work, b_work) = with_depth!(a_info.depth, S => (
-            WorkImage::from_view(&a_img.view::<S>(&a_info)?),
+        (Some((_, i)), _) | (None, Some((_, i))) => i.depth,
+        (None, None) => g.out_info.depth,
+    };
+    let premultiplied =
+        |s: &Option<(HostImage, ImageInfo)>| s.as_ref().is_none_or(|(_, i)| i.premultiplied);
+    if g.frame.warp.method == Method::Auto {
+        let (Some((a_img, a_info)), Some((b_img, b_info))) = (&g.a, &g.b) else {
+            return Err(Failure::BadInput(
+                "method \"auto\" finds its warp from two images: connect both sources (Morph node)"
+                    .into(),
+            ));
+        };
+        let (a_work, b_work) = with_depth!(depth, S => (
+            WorkImage::from_view(&a_img.view::<S>(a_info)?),
             WorkImage::from_view(&b_img.view::<S>(b_info)?),
         ));
         let a_frame = canonical(a_info.bounds, a_scale);
         let b_frame = canonical(b_info.bounds, b_scale);
-        frame.warp.correspondence = Some(correspondence(
+        g.frame.warp.correspondence = Some(correspondence(
             &instance,
-            &frame,
-            time,
+            &g.frame,
+            (g.time, g.sequential),
             (&a_work, a_frame),
             (&b_work, b_frame),
         )?);
     }
-    let scale = PixelScale::new(
-        out_info.render_scale.0,
-        out_info.render_scale.1,
-        out_info.par,
-    );
-    // Maps cover the whole output frame so tiles of one frame share one cached map.
-    let (format_clip, _) = format_clip(kind, effect, &context)?;
-    let rod = format_clip.rod(time)?;
     // Triangles pin the border of the frame, so the whole frame warps.
-    frame.warp.frame = Some(RectD::new(rod.x1, rod.y1, rod.x2, rod.y2));
+    g.frame.warp.frame = Some(warp_frame(effect, &g.rod));
+    if effect.aborted() {
+        return Ok(());
+    }
+    let job = prepare(kind, &instance, &g, out_scale)?;
+    let (a, b) = (&g.a, &g.b);
+    let settings = &g.settings;
+    with_depth!(g.out_info.depth, D => {
+        let rows = out.rows_mut::<D>(&g.out_info, g.window)?;
+        with_depth!(depth, S => {
+            let black = [S::from_f32(BLACK[0]); 4];
+            let edge = |s: &Option<(HostImage, ImageInfo)>| if s.is_some() { settings.edge } else { EdgeMode::Black };
+            let a_sampler = Sampler::new(view_of::<S>(a, &black)?, a_scale, settings.filter, edge(a), premultiplied(a));
+            if kind == NodeKind::Morph {
+                let b_sampler = Sampler::new(view_of::<S>(b, &black)?, b_scale, settings.filter, edge(b), premultiplied(b));
+                job.draw(&a_sampler, Some(&b_sampler), rows);
+            } else {
+                job.draw(&a_sampler, None, rows);
+            }
+        })
+    });
+    Ok(())
+}
+
+/// Everything the pixels depend on, computed (or found in the caches) from
+/// what [`gather`] read: the maps for the render window, the dissolve
+/// weights, the transition rates. Pure given the instance's caches.
+fn prepare<'g>(
+    kind: NodeKind,
+    instance: &'g Instance,
+    g: &'g Gathered,
+    scale: PixelScale,
+) -> Outcome<Job<'g>> {
+    let frame = &g.frame;
+    let view = g.settings.view;
     // The two-pass mesh warp makes pixels (per render window), not a map:
     // pictures take that path, ST maps and the grid the one-pass map.
     let mesh = frame.warp.method == Method::Mesh;
@@ -329,39 +519,32 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         frame.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
     }
     let two_pass = mesh && frame.warp.mesh.pass == Pass::TwoPass;
-    let full = RectI::new(
-        (rod.x1 * scale.x).floor() as i32,
-        (rod.y1 * scale.y).floor() as i32,
-        (rod.x2 * scale.x).ceil() as i32,
-        (rod.y2 * scale.y).ceil() as i32,
-    );
-    let map_window = if full.contains(&window) { full } else { window };
+    // Maps cover the render window, never more: a tile costs its own pixels,
+    // and an infinite region of definition costs nothing extra.
+    let map_window = g.window;
     let map = |side: Side| -> Outcome<Arc<WarpMap>> {
-        let key = key_of(&(&frame, side, map_window, scale.x, scale.y));
+        let key = key_of(&(frame, side, map_window, scale.x, scale.y));
         instance.warps.get_or_compute(key, || {
             let w: Arc<dyn Warp> = if frame.warp.method == Method::ThinPlate {
-                Arc::new(thin_plate(&instance, &frame, side, time)?)
+                Arc::new(thin_plate(instance, frame, side, (g.time, g.sequential))?)
             } else {
                 warp::toward(&frame.features, side, frame.t, &frame.warp)?
             };
             Ok::<_, Failure>(w.map_window(map_window, scale))
         })
     };
-    if effect.aborted() {
-        return Ok(());
-    }
-    let (origin, size) = project(effect, &rod);
-    let picture = matches!(settings.view, View::Morph | View::WarpedA | View::WarpedB);
+    let picture = matches!(view, View::Morph | View::WarpedA | View::WarpedB);
     let bad = |e: morphfx::Error| Failure::BadInput(e.to_string());
+    let two_sources = kind == NodeKind::Morph;
     // A non-uniform colour transition weighs every pixel of the dissolve.
-    let weighted = settings.view == View::Morph
-        && b_img.is_some()
+    let weighted = view == View::Morph
+        && two_sources
         && !frame.warp.transition.colour().is_uniform_at(frame.t);
     // The two-pass mesh warp makes pixels, not maps; weights need maps.
     let by_map = !(two_pass && picture) || weighted;
     let weights = if weighted {
         let (ma, mb) = (map(Side::A)?, map(Side::B)?);
-        let key = key_of(&(&frame, "weights", map_window, scale.x, scale.y));
+        let key = key_of(&(frame, "weights", map_window, scale.x, scale.y));
         Some(instance.weights.get_or_compute(key, || {
             let colour = frame
                 .warp
@@ -374,7 +557,7 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     } else {
         None
     };
-    let rates = if settings.view == View::Transition {
+    let rates = if view == View::Transition {
         Some(
             frame
                 .warp
@@ -384,18 +567,19 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     } else {
         None
     };
-    let job = Job {
-        view: settings.view,
+    let (origin, size) = g.project;
+    Ok(Job {
+        view,
         weights,
         rates,
         t: frame.t,
         features: &frame.features,
-        map_a: if needs_a(settings.view) && by_map {
+        map_a: if needs_a(view) && by_map {
             Some(map(Side::A)?)
         } else {
             None
         },
-        map_b: if needs_b(kind, settings.view) && by_map {
+        map_b: if needs_b(kind, view) && by_map {
             Some(map(Side::B)?)
         } else {
             None
@@ -409,26 +593,7 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         scale,
         origin,
         size,
-    };
-    with_depth!(out_info.depth, D => {
-        let rows = out_img.rows_mut::<D>(&out_info, window)?;
-        with_depth!(a_info.depth, S => {
-            let a_view = a_img.view::<S>(&a_info)?;
-            let a = Sampler::new(a_view, a_scale, settings.filter, settings.edge, a_info.premultiplied);
-            match (&b_img, b_info) {
-                (Some(b_img), Some(b_info)) => {
-                    if b_info.depth != a_info.depth {
-                        return Err(Failure::BadInput("Source A and Source B have different bit depths".into()));
-                    }
-                    let b_view: ImageView<'_, S> = b_img.view::<S>(&b_info)?;
-                    let b = Sampler::new(b_view, b_scale.unwrap_or(a_scale), settings.filter, settings.edge, b_info.premultiplied);
-                    job.draw(&a, Some(&b), rows);
-                }
-                _ => job.draw(&a, None, rows),
-            }
-        })
-    });
-    Ok(())
+    })
 }
 
 /// The canonical rectangle a host image's pixels cover.
@@ -447,7 +612,7 @@ fn canonical(bounds: RectI, scale: PixelScale) -> RectD {
 fn correspondence(
     instance: &Instance,
     frame: &Frame,
-    time: f64,
+    (time, sequential): (f64, bool),
     (a, a_frame): (&WorkImage, RectD),
     (b, b_frame): (&WorkImage, RectD),
 ) -> Outcome<Arc<Correspondence>> {
@@ -465,13 +630,17 @@ fn correspondence(
     ));
     let key = key_of(&(same_setup, a.digest(), b.digest(), &frame.features));
     instance.correspondences.get_or_compute(key, || {
-        let warm = {
-            let grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
-            grids
-                .iter()
-                .find(|(t, k, _)| *t == time - 1.0 && *k == same_setup)
-                .map(|(_, _, g)| g.clone())
-        };
+        // Warm starts only in a sequential render: otherwise the result
+        // would depend on which frames this instance happened to render.
+        let warm = sequential
+            .then(|| {
+                let grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+                grids
+                    .iter()
+                    .find(|(t, k, _)| *t == time - 1.0 && *k == same_setup)
+                    .map(|(_, _, g)| g.clone())
+            })
+            .flatten();
         let started = std::time::Instant::now();
         let (c, table) = auto::correspond(
             a,
@@ -514,16 +683,24 @@ fn correspondence(
 /// solved nearest in time (this frame at another scale, or a neighbouring
 /// frame of the sequence) with the same settings: seed 003's warm start,
 /// since features move little from frame to frame.
-fn thin_plate(instance: &Instance, frame: &Frame, side: Side, time: f64) -> Outcome<ThinPlateWarp> {
+fn thin_plate(
+    instance: &Instance,
+    frame: &Frame,
+    side: Side,
+    (time, sequential): (f64, bool),
+) -> Outcome<ThinPlateWarp> {
     let setup = key_of(&(side, &frame.warp.thin_plate, frame.warp.frame));
-    let warm = {
-        let plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
-        plates
-            .iter()
-            .filter(|(t, k, _)| *k == setup && (t - time).abs() <= 1.0)
-            .min_by(|a, b| (a.0 - time).abs().total_cmp(&(b.0 - time).abs()))
-            .map(|(_, _, p)| p.clone())
-    };
+    // Warm starts only in a sequential render (see `correspondence`).
+    let warm = sequential
+        .then(|| {
+            let plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+            plates
+                .iter()
+                .filter(|(t, k, _)| *k == setup && (t - time).abs() <= 1.0)
+                .min_by(|a, b| (a.0 - time).abs().total_cmp(&(b.0 - time).abs()))
+                .map(|(_, _, p)| p.clone())
+        })
+        .flatten();
     let w = warp::thin_plate_toward(&frame.features, side, frame.t, &frame.warp, warm.as_deref())
         .map_err(|e| Failure::BadInput(e.to_string()))?;
     if std::env::var_os("MORPHFX_VERBOSE").is_some() {
@@ -555,20 +732,18 @@ fn needs_b(kind: NodeKind, view: View) -> bool {
     kind == NodeKind::Morph && matches!(view, View::Morph | View::WarpedB | View::StmapB)
 }
 
-/// The image extent ST maps are normalised by: the project (format) when the
-/// host says, else the source's region of definition.
+/// The rectangle ST maps are normalised by, as (origin, size): the project
+/// when the host says (the spec's project size, placed at the project offset;
+/// the extent is rooted at 0,0 and is not the size), else the source's
+/// region of definition.
 fn project(effect: &Effect, rod: &OfxRectD) -> (Vec2, Vec2) {
     let from_host = effect.props().ok().and_then(|p| {
-        let size = p.get_doubles::<2>(kOfxImageEffectPropProjectExtent).ok()?;
+        let size = p.get_doubles::<2>(kOfxImageEffectPropProjectSize).ok()?;
         let origin = p
             .get_doubles::<2>(kOfxImageEffectPropProjectOffset)
             .unwrap_or([0.0, 0.0]);
-        (size[0] > 0.0 && size[1] > 0.0).then(|| {
-            (
-                Vec2::new(origin[0], origin[1]),
-                Vec2::new(size[0] - origin[0], size[1] - origin[1]),
-            )
-        })
+        (size[0] > 0.0 && size[1] > 0.0)
+            .then(|| (Vec2::new(origin[0], origin[1]), Vec2::new(size[0], size[1])))
     });
     from_host.unwrap_or((
         Vec2::new(rod.x1, rod.y1),

@@ -41,6 +41,12 @@ pub enum Kind {
     },
     /// A push-button: no value, it sends instanceChanged when pressed.
     Button,
+    /// A double the host drives and shows however it likes (the transition
+    /// context's mandated `Transition`): the spec forbids labelling or
+    /// placing it, so only its name, default and range are set.
+    HostDriven {
+        default: f64,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -63,7 +69,11 @@ impl ParamSpec {
     ) -> Self {
         let animates = !matches!(
             kind,
-            Kind::Choice { .. } | Kind::Text { .. } | Kind::Group { .. } | Kind::Bool { .. }
+            Kind::Choice { .. }
+                | Kind::Text { .. }
+                | Kind::Group { .. }
+                | Kind::Bool { .. }
+                | Kind::HostDriven { .. }
         );
         ParamSpec {
             id: id.into(),

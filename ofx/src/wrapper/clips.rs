@@ -136,6 +136,40 @@ impl Effect {
     pub fn error(&self, id: &CStr, text: &str) {
         self.message(kOfxMessageError, id, text);
     }
+
+    /// Sets the node's persistent error (message suite v2), which stays on
+    /// the node until [`Effect::clear_persistent`]. False when the host has
+    /// no v2 suite (the caller then posts a transient message).
+    pub fn persistent_error(&self, id: &CStr, text: &str) -> bool {
+        let Some(f) = self.suites.message_v2.and_then(|s| s.setPersistentMessage) else {
+            return false;
+        };
+        let text = CString::new(text.replace('\0', " ")).unwrap_or_default();
+        // SAFETY: the host's function, given our instance handle, a message
+        // type and id it knows, and a "%s" format with one C string.
+        let status = unsafe {
+            f(
+                self.handle as *mut c_void,
+                kOfxMessageError.as_ptr(),
+                id.as_ptr(),
+                c"%s".as_ptr(),
+                text.as_ptr(),
+            )
+        };
+        status == kOfxStatOK
+    }
+
+    /// Clears the persistent message set by [`Effect::persistent_error`].
+    pub fn clear_persistent(&self) {
+        if let Some(f) = self
+            .suites
+            .message_v2
+            .and_then(|s| s.clearPersistentMessage)
+        {
+            // SAFETY: the host's function, given our instance handle.
+            unsafe { f(self.handle as *mut c_void) };
+        }
+    }
 }
 
 #[derive(Clone)]

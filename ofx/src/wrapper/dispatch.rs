@@ -6,6 +6,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Arc;
 
 use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::image_effect::*;
 
 use super::clips::Effect;
 use super::{Failure, Outcome, BAD_INPUT_ID};
@@ -33,6 +34,10 @@ pub fn dispatch(
                 "forced panic in {} ({FORCE_PANIC})",
                 action.to_string_lossy()
             );
+        }
+        // Suites may be fetched from the load action on (not in setHost).
+        if action == kOfxActionLoad {
+            return super::host::load().map(|()| kOfxStatOK);
         }
         let effect = if handle.is_null() {
             None
@@ -64,15 +69,59 @@ pub fn dispatch(
     }
 }
 
+/// Actions a host runs on render threads (or may): their failures go to the
+/// node's persistent message, since a transient one becomes a modal dialog
+/// per frame and thread in some hosts (Natron).
+const RENDER_TIME: [&CStr; 7] = [
+    kOfxImageEffectActionRender,
+    kOfxImageEffectActionGetRegionOfDefinition,
+    kOfxImageEffectActionGetRegionsOfInterest,
+    kOfxImageEffectActionGetFramesNeeded,
+    kOfxImageEffectActionIsIdentity,
+    kOfxImageEffectActionBeginSequenceRender,
+    kOfxImageEffectActionEndSequenceRender,
+];
+
 fn report(handle: *const c_void, action: &CStr, failure: &Failure) {
     let id = match failure {
         Failure::BadInput(_) => BAD_INPUT_ID,
         _ => c"net.morphfx.Error",
     };
     let text = failure.message();
-    match Effect::new(handle) {
-        Ok(effect) if !handle.is_null() => effect.error(id, text),
-        _ => eprintln!("MorphFX: {}: {text}", action.to_string_lossy()),
+    let effect = match Effect::new(handle) {
+        Ok(effect) if !handle.is_null() => effect,
+        _ => {
+            use std::io::Write;
+            let _ = writeln!(
+                std::io::stderr(),
+                "MorphFX: {}: {text}",
+                action.to_string_lossy()
+            );
+            return;
+        }
+    };
+    if RENDER_TIME.contains(&action) {
+        if let Ok(instance) = instance(&effect) {
+            if effect.persistent_error(id, text) {
+                instance
+                    .error_shown
+                    .store(true, std::sync::atomic::Ordering::Release);
+                return;
+            }
+        }
+    }
+    effect.error(id, text);
+}
+
+/// After a good render: clears the persistent error a failed one left.
+pub fn render_succeeded(effect: &Effect) {
+    if let Ok(instance) = instance(effect) {
+        if instance
+            .error_shown
+            .swap(false, std::sync::atomic::Ordering::AcqRel)
+        {
+            effect.clear_persistent();
+        }
     }
 }
 

@@ -8,7 +8,7 @@ use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 
 use super::dispatch::dispatch;
-use super::host;
+use super::{cpu, host};
 use crate::nodes::{NodeKind, PLUGIN_VERSION};
 
 /// Strings the host may read for as long as the binary is loaded.
@@ -74,6 +74,10 @@ fn statics() -> &'static Statics {
 /// Called by OFX hosts with a valid host struct (or null, refused).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn OfxSetHost(host: *const OfxHost) -> OfxStatus {
+    if let Some(fast) = cpu::fast_build() {
+        // SAFETY: the fast build's own OfxSetHost, given the host's argument.
+        return unsafe { (fast.set_host)(host) };
+    }
     match std::panic::catch_unwind(|| host::set_host(host as *mut OfxHost)) {
         Ok(Ok(())) => kOfxStatOK,
         Ok(Err(f)) => f.status(),
@@ -81,44 +85,23 @@ pub unsafe extern "C" fn OfxSetHost(host: *const OfxHost) -> OfxStatus {
     }
 }
 
-/// Whether this CPU runs the instructions the bundle was built for
-/// (`.cargo/config.toml`: x86-64-v3, AVX2 + FMA). On an older CPU the bundle
-/// offers no plugins, with a message, instead of faulting inside the host.
-fn cpu_supported() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        static OK: OnceLock<bool> = OnceLock::new();
-        *OK.get_or_init(|| {
-            let ok = std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma");
-            if !ok {
-                eprintln!("MorphFX: this CPU lacks AVX2/FMA (x86-64-v3); no plugins offered");
-            }
-            ok
-        })
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    true
-}
-
 #[unsafe(no_mangle)]
 pub extern "C" fn OfxGetNumberOfPlugins() -> c_int {
-    std::panic::catch_unwind(|| {
-        if cpu_supported() {
-            statics().plugins.len() as c_int
-        } else {
-            0
-        }
-    })
-    .unwrap_or(0)
+    if let Some(fast) = cpu::fast_build() {
+        // SAFETY: the fast build's own export, which takes no arguments.
+        return unsafe { (fast.count)() };
+    }
+    std::panic::catch_unwind(|| statics().plugins.len() as c_int).unwrap_or(0)
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn OfxGetPlugin(nth: c_int) -> *mut OfxPlugin {
+    if let Some(fast) = cpu::fast_build() {
+        // SAFETY: the fast build's own export; its plugin structs live as long
+        // as it stays loaded, which is for good.
+        return unsafe { (fast.get)(nth) };
+    }
     std::panic::catch_unwind(|| {
-        if !cpu_supported() {
-            return std::ptr::null_mut();
-        }
         let plugins = &statics().plugins;
         match usize::try_from(nth).ok().and_then(|i| plugins.get(i)) {
             // The host only reads through this pointer.

@@ -1,6 +1,7 @@
-//! The host's suites, fetched once in `OfxSetHost` and shared by all threads.
+//! The host's suites, fetched once in the load action and shared by all threads.
 
 use std::ffi::CStr;
+use std::sync::atomic::{AtomicPtr, Ordering};
 use std::sync::RwLock;
 
 use openfx::sys::generic::core::*;
@@ -17,6 +18,8 @@ pub struct Suites {
     pub effect: &'static OfxImageEffectSuiteV1,
     pub param: &'static OfxParameterSuiteV1,
     pub message: Option<&'static OfxMessageSuiteV1>,
+    /// Persistent messages (render errors stay on the node until cleared).
+    pub message_v2: Option<&'static OfxMessageSuiteV2>,
 }
 
 // SAFETY: the suites are immutable function tables the host keeps alive for as
@@ -28,10 +31,27 @@ unsafe impl Sync for Suites {}
 
 static SUITES: RwLock<Option<Suites>> = RwLock::new(None);
 
-/// Fetches the suites from `host`. Called from `OfxSetHost`.
+/// The host struct from `OfxSetHost` / `setHost`, kept until the load action.
+static HOST: AtomicPtr<OfxHost> = AtomicPtr::new(std::ptr::null_mut());
+
+/// Records the host. The spec lets a plugin fetch suites only from the load
+/// action on, so nothing is fetched here.
 pub fn set_host(host: *mut OfxHost) -> Outcome {
     if host.is_null() {
         return Err(Failure::Failed("OfxSetHost was given a null host".into()));
+    }
+    HOST.store(host, Ordering::Release);
+    Ok(())
+}
+
+/// Fetches the suites (the load action). A host missing a required suite
+/// fails the load with `kOfxStatErrMissingHostFeature` and says which.
+pub fn load() -> Outcome {
+    let host = HOST.load(Ordering::Acquire);
+    if host.is_null() {
+        return Err(Failure::Failed(
+            "the host never called setHost before the load action".into(),
+        ));
     }
     // SAFETY: non-null, and the host promises the struct outlives the binary's use of it.
     let host = unsafe { &*host };
@@ -60,6 +80,7 @@ pub fn set_host(host: *mut OfxHost) -> Outcome {
     let effect = required(kOfxImageEffectSuite, 1)? as *const OfxImageEffectSuiteV1;
     let param = required(kOfxParameterSuite, 1)? as *const OfxParameterSuiteV1;
     let message = get(kOfxMessageSuite, 1) as *const OfxMessageSuiteV1;
+    let message_v2 = get(kOfxMessageSuite, 2) as *const OfxMessageSuiteV2;
     // SAFETY: the host returned these pointers for the named suite versions;
     // they stay valid until the binary is unloaded.
     let suites = unsafe {
@@ -68,9 +89,10 @@ pub fn set_host(host: *mut OfxHost) -> Outcome {
             effect: &*effect,
             param: &*param,
             message: message.as_ref(),
+            message_v2: message_v2.as_ref(),
         }
     };
-    // A later OfxSetHost (a host that reloads us) replaces the suites.
+    // A later load (a host that reloads us) replaces the suites.
     *SUITES.write().unwrap_or_else(|e| e.into_inner()) = Some(suites);
     Ok(())
 }
@@ -79,5 +101,5 @@ pub fn suites() -> Outcome<Suites> {
     SUITES
         .read()
         .unwrap_or_else(|e| e.into_inner())
-        .ok_or_else(|| Failure::Failed("the host never called OfxSetHost".into()))
+        .ok_or_else(|| Failure::Failed("the host never sent the load action".into()))
 }

@@ -3,6 +3,7 @@
 //! maps errors to OFX statuses (DESIGN rule 5).
 
 pub mod clips;
+pub mod cpu;
 pub mod dispatch;
 mod exports;
 pub mod host;

@@ -35,6 +35,7 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
         Kind::Text { .. } => kOfxParamTypeString,
         Kind::Group { .. } => kOfxParamTypeGroup,
         Kind::Button => kOfxParamTypePushButton,
+        Kind::HostDriven { .. } => kOfxParamTypeDouble,
     };
     let name = cstr(&spec.id);
     let mut props: OfxPropertySetHandle = std::ptr::null_mut();
@@ -43,6 +44,14 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
     let status = unsafe { define(param_set, kind.as_ptr(), name.as_ptr(), &mut props) };
     check(status, &format!("defining param {}", spec.id))?;
     let p = PropSet::new(props)?;
+    if let Kind::HostDriven { default } = spec.kind {
+        p.set_double(kOfxParamPropDefault, 0, default)?;
+        let _ = p.set_double(kOfxParamPropMin, 0, 0.0);
+        let _ = p.set_double(kOfxParamPropMax, 0, 1.0);
+        let _ = p.set_double(kOfxParamPropDisplayMin, 0, 0.0);
+        let _ = p.set_double(kOfxParamPropDisplayMax, 0, 1.0);
+        return Ok(());
+    }
     p.set_string(kOfxPropLabel, 0, &spec.label)?;
     // Optional properties: a minimal host may not know them; defining still succeeds.
     let _ = p.set_string(kOfxParamPropHint, 0, &spec.hint);
@@ -118,7 +127,7 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
         Kind::Group { open } => {
             let _ = p.set_int(kOfxParamPropGroupOpen, 0, *open as i32);
         }
-        Kind::Button => {}
+        Kind::Button | Kind::HostDriven { .. } => {}
     }
     Ok(())
 }
