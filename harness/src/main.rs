@@ -525,9 +525,12 @@ impl Job {
             }
             for (view, pattern) in &outputs {
                 inst.set_choice("view", view)?;
-                let out = inst
-                    .render(f as f64, OutputSpec::default())
-                    .map_err(read_error)?;
+                // Frame after frame on one instance: a sequential render.
+                let spec = OutputSpec {
+                    sequential: true,
+                    ..OutputSpec::default()
+                };
+                let out = inst.render(f as f64, spec).map_err(read_error)?;
                 let started = Instant::now();
                 io::write(
                     &frame_path(pattern, f),

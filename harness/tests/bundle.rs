@@ -227,6 +227,7 @@ fn render_morph(case: &Case) -> (Image, Image, Image) {
         tiles: case.tiles,
         // The plugin's own pixels, compared with the core's.
         identity: false,
+        sequential: false,
     };
     inst.begin_sequence(1.0, 1.0).unwrap();
     let out = inst.render(1.0, spec).unwrap();
@@ -608,7 +609,18 @@ fn snap_lines_keys_each_side_onto_its_own_edge_at_the_current_frame() {
         inst.set_double("line1_b_start", &[32.0, 8.0], None)
             .unwrap();
         inst.set_double("line1_b_end", &[32.5, 40.0], None).unwrap();
+        morphfx_harness::host::params::take_edit_log();
         inst.instance_changed("snap_lines", 7.0).unwrap();
+        // One press is one undo step: every key inside one edit block.
+        let log = morphfx_harness::host::params::take_edit_log();
+        assert_eq!(
+            log.first().map(String::as_str),
+            Some("begin Snap Lines"),
+            "{log:?}"
+        );
+        assert_eq!(log.last().map(String::as_str), Some("end"), "{log:?}");
+        assert_eq!(log.len(), 6, "begin, four keys at frame 7, end: {log:?}");
+        assert!(log[1..5].iter().all(|e| e.ends_with("@7")), "{log:?}");
         for (id, edge) in [
             ("line1_a_start", 24.0),
             ("line1_a_end", 24.0),

@@ -77,6 +77,7 @@ const OWN_PIXELS: OutputSpec = OutputSpec {
     render_scale: (1.0, 1.0),
     tiles: 1,
     identity: false,
+    sequential: false,
 };
 
 #[test]
@@ -344,4 +345,28 @@ fn the_bundle_runs_baseline_code_on_a_cpu_without_avx2() {
         }
         Err(_) => eprintln!("qemu-x86_64 not installed: the emulated-CPU check is skipped"),
     }
+}
+
+#[test]
+fn line_points_have_a_range_and_a_display_range() {
+    use openfx::sys::image_effect_v1::param::*;
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let props = inst.param_props("line1_a_start").unwrap();
+    let (min, max) = (
+        props.doubles(kOfxParamPropMin),
+        props.doubles(kOfxParamPropMax),
+    );
+    let (dmin, dmax) = (
+        props.doubles(kOfxParamPropDisplayMin),
+        props.doubles(kOfxParamPropDisplayMax),
+    );
+    assert_eq!((min.len(), max.len(), dmin.len(), dmax.len()), (2, 2, 2, 2));
+    // Wide enough for overscan on a 4K frame, and a display range inside it.
+    assert!(min.iter().all(|v| *v <= -4096.0) && max.iter().all(|v| *v >= 8192.0));
+    assert!(dmin
+        .iter()
+        .zip(&dmax)
+        .all(|(lo, hi)| *lo >= min[0] && lo < hi && *hi <= max[0]));
 }

@@ -499,6 +499,9 @@ pub struct OutputSpec {
     /// Ask isIdentity first and copy the source it names, as hosts do
     /// (off: always render, to compare the plugin's own pixels).
     pub identity: bool,
+    /// This host renders the sequence in frame order on this instance
+    /// (kOfxImageEffectPropSequentialRenderStatus = 1).
+    pub sequential: bool,
 }
 
 impl Default for OutputSpec {
@@ -510,6 +513,7 @@ impl Default for OutputSpec {
             render_scale: (1.0, 1.0),
             tiles: 1,
             identity: true,
+            sequential: false,
         }
     }
 }
@@ -820,7 +824,10 @@ impl Instance<'_> {
             a.set_str(kOfxImageEffectPropFieldToRender, "OfxImageFieldNone");
             a.set_int(kOfxImageEffectPropRenderWindow, &[w.x1, w.y1, w.x2, w.y2]);
             a.set_double(kOfxImageEffectPropRenderScale, &[sx, sy]);
-            a.set_int(kOfxImageEffectPropSequentialRenderStatus, &[0]);
+            a.set_int(
+                kOfxImageEffectPropSequentialRenderStatus,
+                &[spec.sequential as i32],
+            );
             a.set_int(kOfxImageEffectPropInteractiveRenderStatus, &[0]);
             self.act(kOfxImageEffectActionRender, Some(&a), None)
         };

@@ -325,10 +325,49 @@ unsafe extern "C" fn unsupported_copy(
 ) -> OfxStatus {
     kOfxStatErrUnsupported
 }
+thread_local! {
+    /// The plugin's param writes and edit blocks on this thread, in order
+    /// (instanceChanged and interacts run on the thread that calls them):
+    /// open blocks, and the log a test reads back.
+    static EDITS: std::cell::RefCell<(u32, Vec<String>)> =
+        const { std::cell::RefCell::new((0, Vec::new())) };
+}
+
+/// What the plugin wrote on this thread since the last call: `begin NAME`,
+/// `set PARAM` or `set PARAM@TIME`, `end`.
+pub fn take_edit_log() -> Vec<String> {
+    EDITS.with(|e| std::mem::take(&mut e.borrow_mut().1))
+}
+
+fn log_edit(entry: String) {
+    EDITS.with(|e| e.borrow_mut().1.push(entry));
+}
+
 unsafe extern "C" fn edit(_: OfxParamSetHandle) -> OfxStatus {
+    let open = EDITS.with(|e| {
+        let mut e = e.borrow_mut();
+        let open = e.0 > 0;
+        e.0 = e.0.saturating_sub(1);
+        open
+    });
+    if !open {
+        super::violation("paramEditEnd without a paramEditBegin".into());
+        return kOfxStatFailed;
+    }
+    log_edit("end".into());
     kOfxStatOK
 }
-unsafe extern "C" fn edit_begin(_: OfxParamSetHandle, _: *const c_char) -> OfxStatus {
+unsafe extern "C" fn edit_begin(_: OfxParamSetHandle, name: *const c_char) -> OfxStatus {
+    let name = if name.is_null() {
+        String::new()
+    } else {
+        // SAFETY: a NUL-terminated name from the plugin.
+        unsafe { CStr::from_ptr(name) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    EDITS.with(|e| e.borrow_mut().0 += 1);
+    log_edit(format!("begin {name}"));
     kOfxStatOK
 }
 
@@ -421,8 +460,10 @@ pub unsafe extern "C" fn mfx_param_set(
         }
     }
     if at_time != 0 {
+        log_edit(format!("set {}@{time}", p.name));
         p.set_key(time, v);
     } else {
+        log_edit(format!("set {}", p.name));
         p.set(v);
     }
     kOfxStatOK

@@ -653,7 +653,7 @@ fn correspondence(
             warm.as_ref(),
         )
         .map_err(|e| Failure::BadInput(e.to_string()))?;
-        if std::env::var_os("MORPHFX_VERBOSE").is_some() {
+        if crate::wrapper::host::switches().verbose {
             eprintln!(
                 "auto: frame {time}: {}x{} to {}x{}, {} start, {:.2} s\n{}",
                 a.width,
@@ -703,7 +703,7 @@ fn thin_plate(
         .flatten();
     let w = warp::thin_plate_toward(&frame.features, side, frame.t, &frame.warp, warm.as_deref())
         .map_err(|e| Failure::BadInput(e.to_string()))?;
-    if std::env::var_os("MORPHFX_VERBOSE").is_some() {
+    if crate::wrapper::host::switches().verbose {
         let cycles = |r: &Report| r.residuals.len() - 1;
         eprintln!(
             "thin-plate: frame {time} side {side:?}: {} start, {} + {} cycles",

@@ -40,6 +40,8 @@ pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> O
         None => None,
     };
     let count = params.int(LINE_COUNT, time)?.clamp(0, LINE_SLOTS as i32) as usize;
+    // Every endpoint's new key first, then all written as one undo step.
+    let mut keys = Vec::new();
     for k in 1..=count {
         let [enable, a0, a1, b0, b1] = slot_ids(k);
         if params.int(&enable, time)? == 0 {
@@ -54,10 +56,13 @@ pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> O
                 continue;
             }
             let [p, q] = snap_line([p, q], energy, *scale);
-            params.set_point_at(&start, time, (p.x, p.y))?;
-            params.set_point_at(&end, time, (q.x, q.y))?;
+            keys.extend([(start, p), (end, q)]);
         }
     }
+    params.edit_block("Snap Lines", || {
+        keys.iter()
+            .try_for_each(|(id, p)| params.set_point_at(id, time, (p.x, p.y)))
+    })?;
     instance::get(effect)?.purge();
     Ok(())
 }

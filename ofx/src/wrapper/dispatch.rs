@@ -12,10 +12,6 @@ use super::clips::Effect;
 use super::{Failure, Outcome, BAD_INPUT_ID};
 use crate::nodes::{self, Instance, NodeKind};
 
-/// Test hook: `MORPHFX_FORCE_PANIC=<action name>` makes that action panic, so
-/// tests can prove that no unwind crosses the C ABI.
-const FORCE_PANIC: &str = "MORPHFX_FORCE_PANIC";
-
 pub fn dispatch(
     kind: NodeKind,
     action: *const c_char,
@@ -29,9 +25,13 @@ pub fn dispatch(
     // SAFETY: the host passes a NUL-terminated action name (checked non-null).
     let action = unsafe { CStr::from_ptr(action) };
     let result = catch_unwind(AssertUnwindSafe(|| {
-        if std::env::var(FORCE_PANIC).is_ok_and(|a| a.as_bytes() == action.to_bytes()) {
+        let forced = &super::host::switches().force_panic;
+        if forced
+            .as_ref()
+            .is_some_and(|a| a.as_bytes() == action.to_bytes())
+        {
             panic!(
-                "forced panic in {} ({FORCE_PANIC})",
+                "forced panic in {} (MORPHFX_FORCE_PANIC)",
                 action.to_string_lossy()
             );
         }

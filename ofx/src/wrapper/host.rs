@@ -92,9 +92,30 @@ pub fn load() -> Outcome {
             message_v2: message_v2.as_ref(),
         }
     };
+    switches();
     // A later load (a host that reloads us) replaces the suites.
     *SUITES.write().unwrap_or_else(|e| e.into_inner()) = Some(suites);
     Ok(())
+}
+
+/// The plugin's environment switches, read once (at the load action):
+/// hosts call actions from many threads, and reading the environment on
+/// each races with a host that changes its own.
+#[derive(Debug, Default)]
+pub struct Switches {
+    /// `MORPHFX_FORCE_PANIC=<action>`: that action panics (tests prove no
+    /// unwind crosses the C ABI).
+    pub force_panic: Option<String>,
+    /// `MORPHFX_VERBOSE`: solvers say what they did on stderr.
+    pub verbose: bool,
+}
+
+pub fn switches() -> &'static Switches {
+    static SWITCHES: std::sync::OnceLock<Switches> = std::sync::OnceLock::new();
+    SWITCHES.get_or_init(|| Switches {
+        force_panic: std::env::var("MORPHFX_FORCE_PANIC").ok(),
+        verbose: std::env::var_os("MORPHFX_VERBOSE").is_some(),
+    })
 }
 
 pub fn suites() -> Outcome<Suites> {

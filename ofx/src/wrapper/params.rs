@@ -13,6 +13,10 @@ fn cstr(s: &str) -> CString {
     CString::new(s).unwrap_or_default()
 }
 
+/// The range of line-point params (canonical px): twice the largest frame
+/// the warps cover, either side of the origin.
+pub const POINT_RANGE: (f64, f64) = (-131072.0, 131072.0);
+
 /// Defines every param of `specs` on `param_set` (describe-in-context).
 pub fn define_all(param_set: OfxParamSetHandle, specs: &[ParamSpec]) -> Outcome {
     for spec in specs {
@@ -95,6 +99,14 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
         }
         Kind::Point { default } => {
             p.set_doubles(kOfxParamPropDefault, &[default.0, default.1])?;
+            // A real range and display range: hosts that find none clamp
+            // (Resolve to -1..1). Positions may lie outside the frame
+            // (overscan), so the range is wide; sliders show a 4K frame.
+            let (lo, hi) = POINT_RANGE;
+            let _ = p.set_doubles(kOfxParamPropMin, &[lo, lo]);
+            let _ = p.set_doubles(kOfxParamPropMax, &[hi, hi]);
+            let _ = p.set_doubles(kOfxParamPropDisplayMin, &[0.0, 0.0]);
+            let _ = p.set_doubles(kOfxParamPropDisplayMax, &[4096.0, 4096.0]);
             let _ = p.set_string(
                 kOfxParamPropDoubleType,
                 0,
@@ -229,6 +241,24 @@ impl Params {
         let h = self.handle(id)?;
         // SAFETY: a Double2D param takes two `double` varargs after the time.
         check(unsafe { f(h, time, x, y) }, &format!("setting {id}"))
+    }
+
+    /// Runs `writes` inside one edit block (`paramEditBegin`/`paramEditEnd`):
+    /// the host makes it one undo step. The block is closed whatever
+    /// `writes` returns.
+    pub fn edit_block<R>(&self, name: &str, writes: impl FnOnce() -> Outcome<R>) -> Outcome<R> {
+        let (begin, end) = match (self.suite.paramEditBegin, self.suite.paramEditEnd) {
+            (Some(b), Some(e)) => (b, e),
+            _ => return writes(), // a host without edit blocks: plain writes
+        };
+        let label = cstr(name);
+        // SAFETY: the instance's param set and a NUL-terminated label.
+        check(unsafe { begin(self.set, label.as_ptr()) }, "paramEditBegin")?;
+        let result = writes();
+        // SAFETY: closes the block opened just above on the same set.
+        let closed = check(unsafe { end(self.set) }, "paramEditEnd");
+        let value = result?;
+        closed.map(|()| value)
     }
 
     pub fn string(&self, id: &str, time: f64) -> Outcome<String> {
