@@ -443,28 +443,30 @@ impl Job {
             .iter()
             .map(|(clip, p)| (clip.clone(), Plates::new(p)))
             .collect();
-        // Check every input frame up front: a missing or mismatched frame is
-        // reported before anything is written.
-        let mut size = (0, 0);
+        // Check every input frame up front: a missing frame, or one whose
+        // display window differs, is reported before anything is written.
+        // Data windows may differ (overscan, bbox-cropped plates): each is
+        // its clip's region of definition, and the Morph node's output
+        // covers their union.
+        let mut first: Option<((usize, usize), String)> = None;
         for &f in &frames {
-            let mut first: Option<(RectI, (usize, usize), String)> = None;
             for (_, p) in &plates {
                 let path = frame_path(&p.pattern, if is_sequence(&p.pattern) { f } else { 0 });
-                let (bounds, s) = io::probe(&path)?;
+                let (_, s) = io::probe(&path)?;
                 let name = path.display().to_string();
                 match &first {
-                    None => first = Some((bounds, s, name)),
-                    Some((b, s0, n0)) if *s0 != s || *b != bounds => {
+                    None => first = Some((s, name)),
+                    Some((s0, n0)) if *s0 != s => {
                         return Err(HostError::bad(format!(
-                            "size mismatch: {name} is {}x{} but {n0} is {}x{}",
+                            "size mismatch: the display window of {name} is {}x{} but that of {n0} is {}x{}",
                             s.0, s.1, s0.0, s0.1
                         )))
                     }
                     _ => {}
                 }
-                size = s;
             }
         }
+        let size = first.map(|(s, _)| s).unwrap_or_default();
 
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;

@@ -287,3 +287,91 @@ fn demo_renders_every_built_method_with_exact_end_frames() {
         assert!(moved > 0.1, "{method}: the middle frame is plate A");
     }
 }
+
+/// A plate whose data window is `bounds` (canonical, may reach outside the
+/// display window or cover part of it) in a `w × h` display window.
+fn windowed_plate(
+    dir: &Path,
+    name: &str,
+    bounds: RectI,
+    (w, h): (usize, usize),
+    seed: f32,
+) -> (String, Image) {
+    let img = Image::from_fn(bounds, 4, |i, j, c| {
+        if c == 3 {
+            1.0
+        } else {
+            0.5 + 0.4 * (i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin()
+        }
+    });
+    let p = dir.join(name);
+    io::write(
+        &p,
+        &Plate {
+            image: img.clone(),
+            size: (w, h),
+        },
+        ExrPrecision::Float,
+    )
+    .unwrap();
+    (p.to_string_lossy().into_owned(), img)
+}
+
+#[test]
+fn plates_with_other_data_windows_morph_over_the_union_in_the_display_window() {
+    let d = tmp("windows");
+    // A: overscan 8 px on every side (negative origin); B: bbox-cropped.
+    let (a, a_img) = windowed_plate(&d, "a.exr", RectI::new(-8, -8, 72, 56), (64, 48), 0.0);
+    let (b, b_img) = windowed_plate(&d, "b.exr", RectI::new(16, 8, 48, 40), (64, 48), 2.0);
+    // A line that stays put: both warps are the identity.
+    let still = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
+      "features": [{"type": "line", "a": [[10, 10], [40, 12]], "b": [[10, 10], [40, 12]]}]}"#;
+    std::fs::write(d.join("s.morph.json"), still).unwrap();
+    let out = d.join("m.exr");
+    let (code, err) = morphfx(&[
+        "morph",
+        "--scene",
+        d.join("s.morph.json").to_str().unwrap(),
+        "--a",
+        &a,
+        "--b",
+        &b,
+        "--t",
+        "0.5",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let m = io::read(&out).unwrap();
+    assert_eq!(m.size, (64, 48), "the display window is kept");
+    assert_eq!(
+        m.image.bounds,
+        RectI::new(-8, -8, 72, 56),
+        "the union of the data windows"
+    );
+    for (i, j) in [(16, 8), (30, 20), (47, 39)] {
+        let (pa, pb, pm) = (a_img.pixel(i, j), b_img.pixel(i, j), m.image.pixel(i, j));
+        for c in 0..4 {
+            assert!(
+                (pm[c] - 0.5 * (pa[c] + pb[c])).abs() < 1e-5,
+                "({i}, {j}) channel {c}"
+            );
+        }
+    }
+    // OpenImageIO reads the same windows back.
+    if let Ok(info) = Command::new("oiiotool")
+        .arg("--info")
+        .arg("-v")
+        .arg(&out)
+        .output()
+    {
+        let text = String::from_utf8_lossy(&info.stdout);
+        let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            text.contains("80 x 64, 4 channel"),
+            "data window size: {text}"
+        );
+        assert!(text.contains("pixel data origin: x=-8, y=-8"), "{text}");
+        assert!(text.contains("full/display size: 64 x 48"), "{text}");
+    }
+}

@@ -25,7 +25,7 @@ use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT, PLATES_KEPT};
 use super::params::{Settings, OFFSET_A, OFFSET_B};
 use super::NodeKind;
 use crate::cache::key_of;
-use crate::wrapper::clips::{Clip, Depth, Effect, HostImage, ImageInfo};
+use crate::wrapper::clips::{Depth, Effect, HostImage, ImageInfo};
 use crate::wrapper::props::PropSet;
 use crate::wrapper::{Failure, Outcome};
 
@@ -72,27 +72,40 @@ fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
     (a, b)
 }
 
-/// The clip whose frame the output takes, and the time it is read at: A at
-/// its offset, else B at its offset when only B is connected. The region of
-/// definition, the identity answer and the render all use this one answer.
-fn format_source(
-    kind: NodeKind,
-    effect: &Effect,
-    context: &str,
-    time: f64,
-) -> Outcome<(Clip, f64)> {
+/// The output's region of definition at `time`: the union of the connected
+/// sources' regions, each at the time (offset included) it is read - what
+/// hosts' own dissolves do with inputs of different data windows. The
+/// region of definition action and the render use this one answer.
+fn output_region(kind: NodeKind, effect: &Effect, context: &str, time: f64) -> Outcome<OfxRectD> {
     let (a, b) = kind.source_clips(context);
     let (oa, ob) = offsets(kind, effect, time);
-    let clip_a = effect.clip(a)?;
-    if !clip_a.is_connected() {
-        if let Some(b) = b {
-            let clip_b = effect.clip(b)?;
-            if clip_b.is_connected() {
-                return Ok((clip_b, time + ob));
-            }
+    let mut union: Option<OfxRectD> = None;
+    for (name, offset) in std::iter::once((a, oa)).chain(b.map(|b| (b, ob))) {
+        let clip = effect.clip(name)?;
+        if !clip.is_connected() {
+            continue;
         }
+        // A connected clip with no region at this time adds none (its
+        // image is transparent black, like a failed fetch).
+        let Ok(r) = clip.rod(time + offset) else {
+            continue;
+        };
+        union = Some(match union {
+            None => r,
+            Some(u) => OfxRectD {
+                x1: u.x1.min(r.x1),
+                y1: u.y1.min(r.y1),
+                x2: u.x2.max(r.x2),
+                y2: u.y2.max(r.y2),
+            },
+        });
     }
-    Ok((clip_a, time + oa))
+    union.ok_or_else(|| {
+        Failure::BadInput(format!(
+            "no source clip of {} is connected",
+            kind.info().label
+        ))
+    })
 }
 
 pub fn region_of_definition(
@@ -102,8 +115,7 @@ pub fn region_of_definition(
     out_args: &PropSet,
 ) -> Outcome {
     let time = in_args.get_double(kOfxPropTime, 0)?;
-    let (clip, source_time) = format_source(kind, effect, &context(effect), time)?;
-    let rod = clip.rod(source_time)?;
+    let rod = output_region(kind, effect, &context(effect), time)?;
     out_args.set_doubles(
         kOfxImageEffectPropRegionOfDefinition,
         &[rod.x1, rod.y1, rod.x2, rod.y2],
@@ -320,8 +332,8 @@ fn source(effect: &Effect, name: &str, time: f64) -> Outcome<Option<(HostImage, 
 /// infinite region of definition (allowed by the spec) is cut to the project.
 const LARGEST_FRAME: f64 = 65536.0;
 
-/// The canonical frame a warp covers: the format source's region of
-/// definition, or, where that is infinite or absurdly large, the project.
+/// The canonical frame a warp covers: the output's region of definition,
+/// or, where that is infinite or absurdly large, the project.
 fn warp_frame(effect: &Effect, rod: &OfxRectD) -> RectD {
     let r = RectD::new(rod.x1, rod.y1, rod.x2, rod.y2);
     if r.width() <= LARGEST_FRAME && r.height() <= LARGEST_FRAME && r.is_valid() {
@@ -353,7 +365,7 @@ struct Gathered {
     a: Option<(HostImage, ImageInfo)>,
     b: Option<(HostImage, ImageInfo)>,
     out_info: ImageInfo,
-    /// The format source's region of definition at its time.
+    /// The output's region of definition ([`output_region`]).
     rod: OfxRectD,
     project: (Vec2, Vec2),
 }
@@ -395,8 +407,7 @@ fn gather(
         .image(time)?
         .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
     let out_info = out.info()?;
-    let (format_clip, format_time) = format_source(kind, effect, &context, time)?;
-    let rod = format_clip.rod(format_time)?;
+    let rod = output_region(kind, effect, &context, time)?;
     let project = project(effect, &rod);
     let gathered = Gathered {
         time,
