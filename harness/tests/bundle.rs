@@ -4,7 +4,7 @@
 //! shifted image bounds, negative row bytes, and concurrent tiles — for the
 //! field, mesh and triangle methods.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 mod common;
 
@@ -17,25 +17,11 @@ use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp};
 use morphfx::warp::mesh::{two_pass, Mesh, MeshPair};
 use morphfx::warp::triangles::TriangleWarp;
 use morphfx::warp::Warp;
-use morphfx_harness::host::{Bundle, Frame, FrameSource, OutputSpec};
+use morphfx_harness::host::{Frame, OutputSpec};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::param::*;
 
-fn bundle() -> &'static Bundle {
-    static B: OnceLock<Bundle> = OnceLock::new();
-    B.get_or_init(|| {
-        Bundle::load(&common::bundle_path())
-            .expect("the bundle loads (build it with `cargo xtask bundle`)")
-    })
-}
-
-struct Still(Arc<Frame>);
-
-impl FrameSource for Still {
-    fn frame(&self, _time: f64) -> Result<Arc<Frame>, String> {
-        Ok(self.0.clone())
-    }
-}
+use common::{bundle, Still};
 
 const DEPTHS: [&str; 3] = ["OfxBitDepthByte", "OfxBitDepthShort", "OfxBitDepthFloat"];
 

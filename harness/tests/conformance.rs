@@ -4,30 +4,16 @@
 //! suites fetched only from the load action, render-order independence, the
 //! project rectangle, descriptor properties, and the CPU the bundle picks.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 mod common;
 
 use morphfx::geom::{RectI, Vec2};
 use morphfx::image::Image;
-use morphfx_harness::host::{self, Bundle, Frame, FrameSource, OutputSpec};
+use morphfx_harness::host::{self, Frame, FrameSource, OutputSpec};
 use openfx::sys::image_effect_v1::image_effect::*;
 
-fn bundle() -> &'static Bundle {
-    static B: OnceLock<Bundle> = OnceLock::new();
-    B.get_or_init(|| {
-        Bundle::load(&common::bundle_path())
-            .expect("the bundle loads (build it with `cargo xtask bundle`)")
-    })
-}
-
-struct Still(Arc<Frame>);
-
-impl FrameSource for Still {
-    fn frame(&self, _time: f64) -> Result<Arc<Frame>, String> {
-        Ok(self.0.clone())
-    }
-}
+use common::{bundle, Still};
 
 /// A connected clip whose every image fetch fails (Resolve hands back no
 /// image for clips it reports connected).

@@ -406,6 +406,27 @@ pub static SUITE: OfxImageEffectSuiteV1 = OfxImageEffectSuiteV1 {
     imageMemoryUnlock: Some(memory_unlock),
 };
 
+/// A message from the shim's C strings (null ones read as empty).
+///
+/// # Safety
+/// Each pointer is null or a NUL-terminated string (the plugin's, or the
+/// shim's formatted buffer).
+unsafe fn message_of(kind: *const c_char, id: *const c_char, text: *const c_char) -> Message {
+    let s = |p: *const c_char| {
+        if p.is_null() {
+            String::new()
+        } else {
+            // SAFETY: NUL-terminated, per this function's contract.
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+        }
+    };
+    Message {
+        kind: s(kind),
+        id: s(id),
+        text: s(text),
+    }
+}
+
 /// # Safety
 /// Called by the C shim with the plugin's handle (checked against live effects) and C strings.
 #[unsafe(no_mangle)]
@@ -415,19 +436,8 @@ pub unsafe extern "C" fn mfx_message_text(
     id: *const c_char,
     text: *const c_char,
 ) -> c_int {
-    let s = |p: *const c_char| {
-        if p.is_null() {
-            String::new()
-        } else {
-            // SAFETY: NUL-terminated strings from the plugin or the shim's buffer.
-            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-        }
-    };
-    let m = Message {
-        kind: s(kind),
-        id: s(id),
-        text: s(text),
-    };
+    // SAFETY: the shim passes C strings or nulls.
+    let m = unsafe { message_of(kind, id, text) };
     match live_effect(handle) {
         Some(e) => e.messages.lock().unwrap_or_else(|e| e.into_inner()).push(m),
         None => eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text),
@@ -444,23 +454,13 @@ pub unsafe extern "C" fn mfx_persistent_text(
     id: *const c_char,
     text: *const c_char,
 ) -> c_int {
-    let s = |p: *const c_char| {
-        if p.is_null() {
-            String::new()
-        } else {
-            // SAFETY: NUL-terminated strings from the plugin or the shim's buffer.
-            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-        }
-    };
     // The spec: the handle may NOT be null, and must be an instance.
     let Some(e) = live_effect(handle) else {
         return kOfxStatErrBadHandle;
     };
-    *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = Some(Message {
-        kind: s(kind),
-        id: s(id),
-        text: s(text),
-    });
+    // SAFETY: the shim passes C strings or nulls.
+    let m = unsafe { message_of(kind, id, text) };
+    *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = Some(m);
     kOfxStatOK
 }
 

@@ -58,3 +58,23 @@ pub fn colour_plate(
     io::write(path, &plate, ExrPrecision::Float).unwrap();
     image
 }
+
+/// The built bundle, loaded once per test binary.
+#[allow(dead_code)] // not every test file loads it in-process
+pub fn bundle() -> &'static morphfx_harness::host::Bundle {
+    static B: std::sync::OnceLock<morphfx_harness::host::Bundle> = std::sync::OnceLock::new();
+    B.get_or_init(|| {
+        morphfx_harness::host::Bundle::load(&bundle_path())
+            .expect("the bundle loads (build it with `cargo xtask bundle`)")
+    })
+}
+
+/// A clip source that shows one frame at every time.
+#[allow(dead_code)] // not every test file connects clips
+pub struct Still(pub std::sync::Arc<morphfx_harness::host::Frame>);
+
+impl morphfx_harness::host::FrameSource for Still {
+    fn frame(&self, _time: f64) -> Result<std::sync::Arc<morphfx_harness::host::Frame>, String> {
+        Ok(self.0.clone())
+    }
+}
