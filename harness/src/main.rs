@@ -491,6 +491,8 @@ impl Job {
         for (clip, p) in &plates {
             inst.connect(clip, p.clone())?;
         }
+        // Hosts ask for clip preferences once the clips are connected.
+        inst.clip_preferences()?;
         let precision = if c.half {
             ExrPrecision::Half
         } else {

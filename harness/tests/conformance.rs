@@ -356,3 +356,20 @@ fn line_points_have_a_range_and_a_display_range() {
         .zip(&dmax)
         .all(|(lo, hi)| *lo >= min[0] && lo < hi && *hi <= max[0]));
 }
+
+#[test]
+fn the_output_is_declared_frame_varying_and_premultiplied() {
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let a = plate(16, 16, 0.0);
+    inst.connect("SourceA", still(&a)).unwrap();
+    inst.connect("SourceB", still(&a)).unwrap();
+    let prefs = inst.clip_preferences().unwrap();
+    // Natron caches one frame for every time of an output not frame-varying.
+    assert_eq!(prefs.ints(kOfxImageEffectFrameVarying), vec![1]);
+    assert_eq!(
+        prefs.strs(kOfxImageEffectPropPreMultiplication),
+        vec!["OfxImagePreMultiplied".to_owned()]
+    );
+}

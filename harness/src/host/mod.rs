@@ -692,6 +692,19 @@ impl Instance<'_> {
             .map(|_| ())
     }
 
+    /// The plugin's clip preferences (`kOfxImageEffectActionGetClipPreferences`),
+    /// as hosts ask after connecting clips: the out-args it set.
+    pub fn clip_preferences(&self) -> Result<PropertySet, HostError> {
+        let out = PropertySet::new();
+        out.set_int(kOfxImageEffectFrameVarying, &[0]);
+        out.set_str(
+            kOfxImageEffectPropPreMultiplication,
+            "OfxImagePreMultiplied",
+        );
+        self.act(kOfxImageEffectActionGetClipPreferences, None, Some(&out))?;
+        Ok(out)
+    }
+
     /// The output's region of definition at `time` (canonical).
     pub fn region_of_definition(&self, time: f64, scale: (f64, f64)) -> Result<RectI, HostError> {
         let a = PropertySet::new();

@@ -97,6 +97,8 @@ pub fn action(
         render::regions_of_interest(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionGetFramesNeeded) {
         render::frames_needed(kind, &effect, &in_props()?, &out_props()?)?;
+    } else if is(action, kOfxImageEffectActionGetClipPreferences) {
+        render::clip_preferences(kind, &effect, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionIsIdentity) {
         return render::is_identity(kind, &effect, &in_props()?, &out_props()?);
     } else if is(action, kOfxImageEffectActionRender) {

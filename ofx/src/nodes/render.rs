@@ -122,6 +122,32 @@ pub fn region_of_definition(
     )
 }
 
+/// Clip preferences: the output changes from frame to frame (line slots,
+/// scene keyframes and progress all animate), so a host must not cache one
+/// frame for every time; it is premultiplied, as the dissolve is, unless
+/// every connected source is straight (then the samplers keep it straight).
+pub fn clip_preferences(kind: NodeKind, effect: &Effect, out_args: &PropSet) -> Outcome {
+    out_args.set_int(kOfxImageEffectFrameVarying, 0, 1)?;
+    let (a, b) = kind.source_clips(&context(effect));
+    let mut straight = Vec::new();
+    for name in std::iter::once(a).chain(b) {
+        let clip = effect.clip(name)?;
+        if clip.is_connected() {
+            let state = clip
+                .props()?
+                .get_string(kOfxImageEffectPropPreMultiplication, 0)
+                .unwrap_or_default();
+            straight.push(state == "OfxImageUnPreMultiplied");
+        }
+    }
+    let output = if !straight.is_empty() && straight.iter().all(|s| *s) {
+        "OfxImageUnPreMultiplied"
+    } else {
+        "OfxImagePreMultiplied"
+    };
+    out_args.set_string(kOfxImageEffectPropPreMultiplication, 0, output)
+}
+
 /// A warp can pull from anywhere: ask for each source's whole region, at the
 /// frame (offset included) that source is read for this render.
 pub fn regions_of_interest(
