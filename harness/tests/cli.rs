@@ -22,21 +22,18 @@ fn tmp(name: &str) -> PathBuf {
     common::scratch(name)
 }
 
+/// Writes `image` as a float EXR in a `size` display window; returns its path.
+fn write_plate(dir: &Path, name: &str, image: Image, size: (usize, usize)) -> String {
+    let p = dir.join(name);
+    io::write(&p, &Plate { image, size }, ExrPrecision::Float).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
 fn plate(dir: &Path, name: &str, w: usize, h: usize, seed: f32) -> String {
     let img = Image::from_fn(RectI::from_size(w, h), 4, |i, j, c| {
         (i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin() * 2.0
     });
-    let p = dir.join(name);
-    io::write(
-        &p,
-        &Plate {
-            image: img,
-            size: (w, h),
-        },
-        ExrPrecision::Float,
-    )
-    .unwrap();
-    p.to_string_lossy().into_owned()
+    write_plate(dir, name, img, (w, h))
 }
 
 const TRANSLATE: &str = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
@@ -294,7 +291,7 @@ fn windowed_plate(
     dir: &Path,
     name: &str,
     bounds: RectI,
-    (w, h): (usize, usize),
+    size: (usize, usize),
     seed: f32,
 ) -> (String, Image) {
     let img = Image::from_fn(bounds, 4, |i, j, c| {
@@ -304,17 +301,7 @@ fn windowed_plate(
             0.5 + 0.4 * (i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin()
         }
     });
-    let p = dir.join(name);
-    io::write(
-        &p,
-        &Plate {
-            image: img.clone(),
-            size: (w, h),
-        },
-        ExrPrecision::Float,
-    )
-    .unwrap();
-    (p.to_string_lossy().into_owned(), img)
+    (write_plate(dir, name, img.clone(), size), img)
 }
 
 #[test]

@@ -450,9 +450,6 @@ fn gather(
     Ok((gathered, out))
 }
 
-/// Transparent black, standing in for a source the host has no image of.
-const BLACK: [f32; 4] = [0.0; 4];
-
 /// A view over `source`'s pixels, or over one transparent black pixel.
 fn view_of<'a, S: Sample>(
     source: &'a Option<(HostImage, ImageInfo)>,
@@ -524,7 +521,8 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     with_depth!(g.out_info.depth, D => {
         let rows = out.rows_mut::<D>(&g.out_info, g.window)?;
         with_depth!(depth, S => {
-            let black = [S::from_f32(BLACK[0]); 4];
+            // Transparent black: the stand-in for a source with no image.
+            let black = [S::default(); 4];
             let edge = |s: &Option<(HostImage, ImageInfo)>| if s.is_some() { settings.edge } else { EdgeMode::Black };
             let a_sampler = Sampler::new(view_of::<S>(a, &black)?, a_scale, settings.filter, edge(a), premultiplied(a));
             if kind == NodeKind::Morph {
