@@ -373,3 +373,47 @@ fn the_output_is_declared_frame_varying_and_premultiplied() {
         vec!["OfxImagePreMultiplied".to_owned()]
     );
 }
+
+#[test]
+fn a_warm_started_thin_plate_matches_a_cold_one_at_another_scale() {
+    // A viewer renders full size, then a proxy of the same frame: the warm
+    // start from the full-size plates must land on the same warp.
+    let a = plate(96, 64, 0.0);
+    let render = |scales: &[f64]| {
+        let inst = bundle()
+            .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
+            .unwrap();
+        // One horizontal line, its ends moving apart vertically: the plates
+        // were free to tilt about it.
+        inst.set_int("line_count", 1).unwrap();
+        for (id, xy) in [
+            ("line1_a_start", [60.0, 50.0]),
+            ("line1_a_end", [80.0, 50.0]),
+            ("line1_b_start", [62.0, 48.0]),
+            ("line1_b_end", [82.0, 53.0]),
+        ] {
+            inst.set_double(id, &xy, None).unwrap();
+        }
+        inst.set_int("method", 3).unwrap(); // thin-plate
+        inst.set_project(96.0, 64.0);
+        inst.connect("Source", still(&a)).unwrap();
+        let mut last = None;
+        for &s in scales {
+            let spec = OutputSpec {
+                render_scale: (s, s),
+                sequential: true,
+                ..OWN_PIXELS
+            };
+            last = Some(inst.render(0.0, spec).unwrap().to_image());
+        }
+        last.unwrap()
+    };
+    let (warm, cold) = (render(&[1.0, 0.5]), render(&[0.5]));
+    let worst = warm
+        .data
+        .iter()
+        .zip(&cold.data)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-3, "warm and cold proxies differ by {worst}");
+}

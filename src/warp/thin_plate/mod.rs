@@ -5,6 +5,7 @@
 //! to, so the map is exactly the discrete model that was solved.
 
 pub mod multigrid;
+mod pinning;
 pub mod plate;
 
 use super::node_grid::NodeGrid;
@@ -49,13 +50,17 @@ pub struct ThinPlate {
 impl ThinPlate {
     /// The plates whose displacements carry each `from` to its `to`, over
     /// `frame`. `warm`: a previous solution on the same grid to start from
-    /// (a sequence's previous frame), else the plates start flat.
+    /// (a sequence's previous frame), else the plates start flat. Features
+    /// on one point or one line are completed by [`pinning`] so that the
+    /// plates are unique, whatever the start.
     pub fn solve(
         pairs: &[(Vec2, Vec2)],
         frame: RectD,
         s: &ThinPlateSettings,
         warm: Option<&ThinPlate>,
     ) -> ThinPlate {
+        let pinned = pinning::pin_free_modes(pairs, frame, s.cell);
+        let pairs = pinned.as_slice();
         let (origin, nx, ny, levels) = layout(frame, pairs, s.cell);
         let mut nodes = NodeGrid {
             origin,
