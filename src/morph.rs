@@ -1,5 +1,5 @@
 //! The in-between image: both sources warped toward the same feature positions
-//! and dissolved (seed 002 §3.4).
+//! and dissolved (Beier-Neely §3.4).
 
 use crate::image::bilinear_rgba::{blend_row, Taps};
 use crate::image::resample::{adapt_channels, fill_rows, map_span, row_through};
@@ -117,7 +117,7 @@ pub fn dissolve<S: Sample, D: Sample>(
     });
 }
 
-/// The dissolve with a weight per pixel and side (seed 000 §3: `I = W0 •
+/// The dissolve with a weight per pixel and side (Lee, Wolberg et al. §3: `I = W0 •
 /// ((1 − T0) I0) + W1 • (T1 I1)`): `dst = w_a · A + w_b · B`, weights from
 /// [`crate::transition::colour_weights`] over a window that covers `dst`
 /// (pixels outside it take the plain `1 − t`, `t`).

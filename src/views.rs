@@ -87,7 +87,7 @@ pub const GRID_SPACING: f64 = 32.0;
 
 /// A grid drawn in source space, seen through `map`, with `features` (at the
 /// output's positions) drawn on top in orange: shows where each region of the
-/// source lands and why (seed 002 §4's "ghostbusting" aid).
+/// source lands and why (Beier-Neely §4's "ghostbusting" aid).
 pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: RowsMut<'_, D>) {
     let segments: Vec<(Vec2, Vec2)> = features
         .iter()

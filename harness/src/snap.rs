@@ -1,5 +1,5 @@
 //! `morphfx snap`: refines a scene's polylines and curves on both images with
-//! snakes (seed 000 §4.2) and writes the refined scene. A feature tool, not a
+//! snakes (Lee, Wolberg et al. §4.2) and writes the refined scene. A feature tool, not a
 //! render: it runs the core's snakes on the plates directly.
 //!
 //! Each polyline or curve is sampled into snake points on A and on B (the

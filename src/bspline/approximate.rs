@@ -1,7 +1,7 @@
 use super::{basis, Lattice};
 use crate::geom::Vec2;
 
-/// The least-squares control displacements of seed 000 §5.3: each point asks
+/// The least-squares control displacements of Lee, Wolberg et al. §5.3: each point asks
 /// its 16 controls for `φ_kl = w_kl Δq / Σ w_ab²` (eq. 4, the smallest
 /// displacements that move it by `Δq`); a control shared by several points
 /// takes `Σ w_c² φ_c / Σ w_c²` (eq. 5). Controls no point reads stay zero.

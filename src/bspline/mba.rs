@@ -1,4 +1,4 @@
-//! Multilevel B-spline interpolation (seed 000 §6.2): a coarse lattice
+//! Multilevel B-spline interpolation (Lee, Wolberg et al. §6.2): a coarse lattice
 //! catches the overall shape, each finer one the deviations the coarser left.
 //! Unlike MFFD nothing is truncated, so each lattice is fitted once.
 //!

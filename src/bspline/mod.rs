@@ -1,4 +1,4 @@
-//! Uniform cubic B-spline lattices over the plane (seed 000 §5.1, §6.1): the
+//! Uniform cubic B-spline lattices over the plane (Lee, Wolberg et al. §5.1, §6.1): the
 //! free-form deformations of MFFD and the surfaces of multilevel B-spline
 //! interpolation are both sums `Σ B_k(s) B_l(t) φ`. One lattice type serves
 //! both; a deformation is a pair of them (x and y displacements).

@@ -1,5 +1,5 @@
 //! Feature primitives: points, directed lines, polylines and Catmull-Rom curves,
-//! each with a position on image A and one on image B (seed 000 §4.2).
+//! each with a position on image A and one on image B (Lee, Wolberg et al. §4.2).
 
 mod catmull_rom;
 mod sampling;
@@ -117,7 +117,7 @@ impl Feature {
 
 /// Where each feature point is along its way from A to B at one instant:
 /// one progress `t` for every point, or a rate per point taken from its
-/// position on A (transition control, seed 000 §3: `T0(p; t)`).
+/// position on A (transition control, Lee, Wolberg et al. §3: `T0(p; t)`).
 #[derive(Clone, Copy)]
 pub struct Tween<'a> {
     pub t: f64,

@@ -1,5 +1,5 @@
 //! Uniform sampling of polylines and curves into corresponding points
-//! (seed 000 §4.2: "20 points per segment"), shared by every point-based method
+//! (Lee, Wolberg et al. §4.2: "20 points per segment"), shared by every point-based method
 //! and by the field method's treatment of curves.
 
 use super::{catmull_rom, Feature, FeatureKind, Side};

@@ -88,7 +88,7 @@ pub struct Scene {
     pub hybrid: HybridSettings,
     /// Transition control (scene key `transition`).
     pub transition: TransitionSettings,
-    /// Samples per polyline/curve span for point-based methods (seed 000 §4.2).
+    /// Samples per polyline/curve span for point-based methods (Lee, Wolberg et al. §4.2).
     pub samples_per_segment: usize,
     /// The features when there are no keyframes.
     pub features: Vec<Feature>,

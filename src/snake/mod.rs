@@ -1,4 +1,4 @@
-//! Snakes for feature placement (seed 000 §4.1–4.2): a polyline or curve is
+//! Snakes for feature placement (Lee, Wolberg et al. §4.1–4.2): a polyline or curve is
 //! sampled into points that slither toward nearby edges under image forces
 //! while a thin-plate bending energy keeps them smooth.
 //!

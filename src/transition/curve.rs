@@ -1,4 +1,4 @@
-//! A transition curve (seed 003 Fig. 2): the rate of transition of a point
+//! A transition curve (Lee et al. Fig. 2): the rate of transition of a point
 //! over progress `t`, from 0 (A) to 1 (B).
 
 use crate::error::{Error, Result};

@@ -1,4 +1,4 @@
-//! Transition control (seed 000 §3 and §6, seed 003 §3.3): how fast each
+//! Transition control (Lee, Wolberg et al. §3 and §6, Lee et al. §3.3): how fast each
 //! point of A travels toward its place on B (geometry) and how fast its colour
 //! gives way to B's (colour), as a rate `T0(p; t) ∈ [0, 1]` per point of A.
 //!
@@ -44,9 +44,9 @@ pub struct Attached {
 /// How the curves' rates spread over the image.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Propagation {
-    /// Multilevel B-spline interpolation (seed 000 §6.2): C².
+    /// Multilevel B-spline interpolation (Lee, Wolberg et al. §6.2): C².
     BSpline(MbaSettings),
-    /// The thin plate (seed 003 §3.3): C¹.
+    /// The thin plate (Lee et al. §3.3): C¹.
     ThinPlate(ThinPlateSettings),
 }
 
@@ -69,7 +69,7 @@ pub enum Transition {
 }
 
 /// The geometry transition, and the colour one (`None`: the same as the
-/// geometry, as seed 000 §3 treats them).
+/// geometry, as Lee, Wolberg et al. §3 treats them).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TransitionSettings {
     pub geometry: Transition,
@@ -204,7 +204,7 @@ impl Transition {
 }
 
 /// The curves' points on A and what each asks of the surface, `C(t) − t`
-/// (seed 003 §3.3: `ΔT = C − t`, so `T0 = t + ΔT`).
+/// (Lee et al. §3.3: `ΔT = C − t`, so `T0 = t + ΔT`).
 pub fn constraints(
     curves: &[Attached],
     features: &[Feature],
@@ -237,7 +237,7 @@ pub fn constraints(
     Ok(points)
 }
 
-/// Per-pixel weights of the dissolve (seed 000 §3): A's colour attenuated by
+/// Per-pixel weights of the dissolve (Lee, Wolberg et al. §3): A's colour attenuated by
 /// `1 − T0` at the point it comes from, B's by `T1 = T0 ∘ W1` at its point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Weights {

@@ -1,4 +1,4 @@
-//! Procedural transitions (seed 003 §4.2, seed 000 Figs. 17–18): the rate of
+//! Procedural transitions (Lee et al. §4.2, Lee, Wolberg et al. Figs. 17–18): the rate of
 //! a point follows from where it is. A spatial pattern `g(p) ∈ [0, 1]` says
 //! when a point's turn comes; each point crosses from A to B over a window
 //! of `1 − spread` of the progress, starting at `spread · g(p)`:

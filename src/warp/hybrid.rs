@@ -1,4 +1,4 @@
-//! The hybrid method (seed 000 §5.5): the thin plate solved on a coarse grid
+//! The hybrid method (Lee, Wolberg et al. §5.5): the thin plate solved on a coarse grid
 //! gives the global shape cheaply; a cubic B-spline through its nodes carries
 //! it to every point (C², seed: "B-spline propagation"); MFFD then starts
 //! from that warp, on lattices no coarser than the plate's grid, to meet the

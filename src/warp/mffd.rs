@@ -1,4 +1,4 @@
-//! Multilevel free-form deformation (seed 000 §5): one-to-one warps from
+//! Multilevel free-form deformation (Lee, Wolberg et al. §5): one-to-one warps from
 //! scattered point pairs.
 //!
 //! Each step is a cubic B-spline FFD whose control displacements come from the
@@ -277,7 +277,7 @@ impl Mffd {
     }
 }
 
-/// One FFD manipulation (seed 000 §5.3's algorithm) on a lattice of spacing `h`
+/// One FFD manipulation (Lee, Wolberg et al. §5.3's algorithm) on a lattice of spacing `h`
 /// that covers the frame and every point.
 fn ffd_step(at: &[Vec2], targets: &[Vec2], frame: RectD, h: f64, truncate: bool) -> Deformation {
     let area = frame.including(at.iter().chain(targets).copied());

@@ -382,7 +382,7 @@ impl WarpSettings {
 }
 
 /// Every feature's corresponding points (polylines and curves sampled
-/// `per_segment` times per span, seed 000 §4.2) as `(in-between, source)`
+/// `per_segment` times per span, Lee, Wolberg et al. §4.2) as `(in-between, source)`
 /// pairs for the scattered-data methods: the reverse map carries each
 /// in-between position to its place on `side`.
 pub fn point_pairs_toward(

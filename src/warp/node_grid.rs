@@ -1,6 +1,6 @@
 //! Displacements on a regular grid of nodes, bilinear between them: how the
 //! thin plate is discretised, and how MFFD's composed deformations reach every
-//! pixel without composing at every pixel (seed 000 §5.6).
+//! pixel without composing at every pixel (Lee, Wolberg et al. §5.6).
 
 use rayon::prelude::*;
 

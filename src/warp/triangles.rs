@@ -1,4 +1,4 @@
-//! Triangulated morphing (seed 001: "The program builds triangles from these
+//! Triangulated morphing (Wolberg: "The program builds triangles from these
 //! points ... a linear blend of the contents of the triangles using
 //! barycentric geometry"): the feature points, plus the frame's corners and
 //! border points so the whole frame warps, triangulated by Delaunay (spade,
@@ -107,7 +107,7 @@ pub struct TriangleWarp {
 
 impl TriangleWarp {
     /// Triangulates every feature's points (polylines and curves sampled
-    /// `per_segment` times per span, seed 000 §4.2) with the border of `frame`.
+    /// `per_segment` times per span, Lee, Wolberg et al. §4.2) with the border of `frame`.
     /// Where two features meet at one in-between position, the first wins.
     pub fn toward<'a>(
         features: &[Feature],

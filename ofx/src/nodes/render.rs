@@ -716,7 +716,7 @@ fn correspondence(
 
 /// The frame's thin plates on `side`, solved from the plates this instance
 /// solved nearest in time (this frame at another scale, or a neighbouring
-/// frame of the sequence) with the same settings: seed 003's warm start,
+/// frame of the sequence) with the same settings: Lee et al.'s warm start,
 /// since features move little from frame to frame.
 fn thin_plate(
     instance: &Instance,

@@ -1,4 +1,4 @@
-//! The Snap Lines push-button (seed 000 §4.2): every enabled line slot slides
+//! The Snap Lines push-button (Lee, Wolberg et al. §4.2): every enabled line slot slides
 //! onto the nearest strong edge of its source at the current frame — A
 //! positions on Source A, B positions on Source B (Morph) — and the moved
 //! endpoints are keyed there, so the user places lines roughly and lets the

@@ -1,4 +1,4 @@
-//! The warp `auto` searches over (seed 004 §3): a bilinear uniform B-spline
+//! The warp `auto` searches over (Gao-Sederberg §3): a bilinear uniform B-spline
 //! map `F_i` of the unit square with `2^i x 2^i` patches, i.e. a grid of
 //! `(2^i + 1)^2` control points, each the image on B of a lattice point of A.
 //! Origin bottom-left, y up, as in the paper and in our canonical coordinates.
@@ -23,7 +23,7 @@ impl std::fmt::Debug for Grid {
     }
 }
 
-/// Where a control point may move (seed 004 §5: corners are fixed, edge
+/// Where a control point may move (Gao-Sederberg §5: corners are fixed, edge
 /// vertices slide along their edge).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Freedom {
@@ -162,7 +162,7 @@ impl Grid {
             .find(|&(j, k)| !is_convex_ccw(&self.quad(j, k)))
     }
 
-    /// Onto (seed 004 §3): corners at the corners, edge points on their edges.
+    /// Onto (Gao-Sederberg §3): corners at the corners, edge points on their edges.
     pub fn is_onto(&self) -> bool {
         let n = self.n();
         (0..=n).all(|k| {
@@ -178,7 +178,7 @@ impl Grid {
         })
     }
 
-    /// Pulls a grid that has left the frame's edges back onto them (seed 004
+    /// Pulls a grid that has left the frame's edges back onto them (Gao-Sederberg
     /// §6.2: a user's initial warp may pull away; F_3 is forced onto). A
     /// boundary point whose snap would fold a quad goes back to its lattice
     /// position instead; returns false (grid unchanged) if even that folds.

@@ -1,5 +1,5 @@
 //! `auto`: automatic morphing by work minimisation (Gao & Sederberg 1998,
-//! seed 004). The correspondence is a hierarchical bilinear B-spline warp
+//! Gao-Sederberg). The correspondence is a hierarchical bilinear B-spline warp
 //! `F` from A's unit square onto B's, found by greedy search of the work
 //! (re-colouring + stretching + angle change + anchor penalties); the morph
 //! then blends A's lattice with `F`'s control points ([`QuadWarp`]).

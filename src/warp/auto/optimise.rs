@@ -1,4 +1,4 @@
-//! The hierarchical search of seed 004 §5: level by level, every control
+//! The hierarchical search of Gao-Sederberg §5: level by level, every control
 //! point tries offset positions `F̂_i(P + s δ)` and keeps the best one that
 //! lowers the work and keeps every quad convex and counter-clockwise.
 //!

@@ -1,4 +1,4 @@
-//! The work of a warp (seed 004 §4, eq. 5): re-colouring (6), stretching (7),
+//! The work of a warp (Gao-Sederberg §4, eq. 5): re-colouring (6), stretching (7),
 //! angle change (8) and the anchor penalty (9), per quad, so a move of one
 //! control point is re-priced from its four quads only.
 //!

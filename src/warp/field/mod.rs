@@ -1,4 +1,4 @@
-//! Beier-Neely field warping (seed 002 §3): every directed line pair pulls
+//! Beier-Neely field warping (Beier-Neely §3): every directed line pair pulls
 //! nearby pixels along with it, weighted by eq. (4).
 
 mod kernel;
@@ -13,7 +13,7 @@ use crate::geom::{PixelScale, RectI, Vec2};
 use crate::warp::{Warp, WarpMap};
 use weight::Weight;
 
-/// How lines move from their A to their B position over `t` (seed 002 §3.4).
+/// How lines move from their A to their B position over `t` (Beier-Neely §3.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum LineInterpolation {
     /// Endpoints move on straight paths (a rotating line shrinks mid-way).

@@ -1,4 +1,4 @@
-//! Fant's 1-D resampling (seed 001, `resample`): linear interpolation where a
+//! Fant's 1-D resampling (Wolberg, `resample`): linear interpolation where a
 //! line is magnified, box filtering (unweighted averaging) where it is
 //! minified, so squeezed regions average instead of aliasing.
 //!

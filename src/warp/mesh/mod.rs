@@ -1,4 +1,4 @@
-//! Mesh warping (seed 001: Smythe's algorithm at ILM as published by Wolberg).
+//! Mesh warping (Wolberg: Smythe's algorithm at ILM as published by Wolberg).
 //! Two meshes of control points, topologically equal, say where landmarks of
 //! the source sit and where they go; Catmull-Rom splines through the mesh
 //! columns and rows carry the motion to every pixel.
@@ -110,7 +110,7 @@ impl Mesh {
 
     /// The rules that keep the two-pass splines and the patches one-to-one:
     /// finite nodes, columns rising and rows running right strictly
-    /// (seed 001: "It is important that the mesh not self-intersect"), every
+    /// (Wolberg: "It is important that the mesh not self-intersect"), every
     /// cell a convex counter-clockwise quad. `name` goes into the message.
     pub fn check(&self, name: &str) -> Result<()> {
         let bad = |what: String| Err(Error::Invalid(format!("{name}: {what}")));
@@ -169,7 +169,7 @@ impl Mesh {
 /// How a mesh warp is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Pass {
-    /// Rows then columns with Fant's filter (seed 001's algorithm).
+    /// Rows then columns with Fant's filter (Smythe's algorithm as Wolberg lists it).
     #[default]
     TwoPass,
     /// Bicubic patches inverted per output pixel: a reverse map.
@@ -204,7 +204,7 @@ pub struct MeshPair {
 }
 
 impl MeshPair {
-    /// Checks both meshes and that their borders are frozen (seed 001: "the
+    /// Checks both meshes and that their borders are frozen (Wolberg: "the
     /// first and last rows and columns all remain intact throughout the
     /// warp"). Meshes listed top row first are turned to bottom row first.
     pub fn new(a: Mesh, b: Mesh) -> Result<MeshPair> {
@@ -243,13 +243,13 @@ impl MeshPair {
         }
     }
 
-    /// The in-between mesh at `t` (seed 001 `morph`: nodes interpolated linearly).
+    /// The in-between mesh at `t` (Wolberg `morph`: nodes interpolated linearly).
     pub fn at(&self, t: f64) -> Mesh {
         self.a.lerp(&self.b, t)
     }
 
     /// The in-between mesh with each node at its own rate (transition control:
-    /// Smythe's per-node transition curves, seed 003 §1).
+    /// Smythe's per-node transition curves, Lee et al. §1).
     pub fn tween(&self, t: Tween<'_>) -> Mesh {
         if t.is_uniform() {
             return self.at(t.t);

@@ -1,5 +1,5 @@
 //! Catmull-Rom interpolation of `y = f(x)` through knots with any spacing,
-//! as in Wolberg's `catmullRom` (seed 001 listing): the tangent at a knot is
+//! as in Wolberg's `catmullRom` (his listing): the tangent at a knot is
 //! the slope between its neighbours, the end tangents the slope of the end
 //! interval. It passes through every knot and reproduces straight lines
 //! exactly, which is why an affinely moved mesh warps affinely.

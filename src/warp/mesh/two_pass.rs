@@ -1,4 +1,4 @@
-//! Smythe's two-pass mesh warp (seed 001, `meshWarp`), for any channel count
+//! Smythe's two-pass mesh warp (Wolberg, `meshWarp`), for any channel count
 //! and float data, in parallel.
 //!
 //! The intermediate mesh takes its x from the destination and its y from the

@@ -1,4 +1,4 @@
-//! Deformable-surface warps (seed 003): the x and y displacements are two
+//! Deformable-surface warps (Lee et al.): the x and y displacements are two
 //! thin plates pulled by springs toward the constraint displacements and held
 //! by glue, each solved by multigrid on a node grid over the frame. The
 //! warp between nodes is bilinear, the same interpolant the springs attach

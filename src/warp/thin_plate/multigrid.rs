@@ -1,4 +1,4 @@
-//! Multigrid V-cycles for the plate (seed 003 §2.2, after Terzopoulos):
+//! Multigrid V-cycles for the plate (Lee et al. §2.2, after Terzopoulos):
 //! Gauss-Seidel smoothing with each spring's nodes relaxed as a block,
 //! cubic B-spline prolongation `P`, its transpose as restriction, and
 //! Galerkin coarse systems `A_c = Pᵀ A P`, solved directly (banded

@@ -1,4 +1,4 @@
-//! The discrete plate of seed 003 §2 on one grid: the linear system
+//! The discrete plate of Lee et al. §2 on one grid: the linear system
 //! `A f = b` whose solution minimises
 //!
 //! ```text
