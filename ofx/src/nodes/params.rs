@@ -70,16 +70,20 @@ pub fn slot_ids(k: usize) -> [String; 5] {
     ]
 }
 
-fn method_options() -> Vec<&'static str> {
+/// The methods a node offers, in choice order (hosts save the index: only
+/// ever append). Auto finds its warp from both pictures, so the Warp node,
+/// which has one, stops before it; auto is last, so no index moves.
+fn method_options(kind: NodeKind) -> Vec<&'static str> {
     Method::ALL
         .iter()
+        .filter(|m| kind == NodeKind::Morph || **m != Method::Auto)
         .map(|m| match m {
             Method::Field => "field",
             Method::Mesh => "mesh",
             Method::Triangles => "triangles",
-            Method::ThinPlate => "thin-plate (not yet available)",
-            Method::Mffd => "mffd (not yet available)",
-            Method::Hybrid => "hybrid (not yet available)",
+            Method::ThinPlate => "thin-plate",
+            Method::Mffd => "mffd",
+            Method::Hybrid => "hybrid",
             Method::Auto => "auto",
         })
         .collect()
@@ -106,7 +110,7 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
     let c = Coefficients::default();
     let tp = ThinPlateSettings::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs (seed 003); mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto: the least-work warp of A onto B found from the images (Morph node only), features acting as anchors.", Kind::Choice { options: method_options(), default: 0 }),
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", Kind::Choice { options: method_options(kind), default: 0 }),
         ParamSpec::new(
             PROGRESS,
             "Progress",
