@@ -1,8 +1,12 @@
 //! Developer tasks: `cargo xtask bundle [--release]`, `cargo xtask demo [-o DIR]`,
-//! `cargo xtask test`. Builds the plugin bundle first so the harness finds it.
+//! `cargo xtask test`, `cargo xtask refhost` (the reference host check alone).
+//! Builds the plugin bundle first so the harness finds it.
 
 use std::path::{Path, PathBuf};
 use std::process::{exit, Command};
+
+mod refhost;
+mod tools;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -125,6 +129,7 @@ fn main() {
             let b = bundle(args.iter().any(|a| a == "--release"));
             println!("bundle: {}", b.display());
         }
+        Some("refhost") => refhost::check(&bundle(false)),
         Some("demo") => {
             let b = bundle(true);
             let status = morphfx(true, &b)
@@ -144,11 +149,12 @@ fn main() {
             let mut run = vec!["test", "--workspace"];
             run.extend(args[1..].iter().map(String::as_str));
             cargo(&run);
+            refhost::check(&b);
             cmake_install_check();
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask bundle [--release] | demo [-o DIR] | test [cargo test args]"
+                "usage: cargo xtask bundle [--release] | demo [-o DIR] | test [cargo test args] | refhost"
             );
             exit(2);
         }
@@ -156,36 +162,12 @@ fn main() {
 }
 
 /// The EXR cross-check reads our outputs with OpenImageIO's `oiiotool`;
-/// install it when missing and this machine can (root with apt-get).
+/// install it when missing and this machine can.
 fn ensure_openimageio() {
-    let found = |tool: &str| {
-        Command::new(tool)
-            .arg("--version")
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
-    if found("oiiotool") {
+    if tools::runs("oiiotool", &["--version"])
+        || tools::apt_install(&["openimageio-tools"], "the EXR cross-check")
+    {
         return;
-    }
-    let is_root = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| o.stdout.starts_with(b"0"));
-    if is_root && found("apt-get") {
-        println!("installing openimageio-tools for the EXR cross-check (apt-get)...");
-        let apt = |args: &[&str]| {
-            Command::new("apt-get")
-                .args(args)
-                .env("DEBIAN_FRONTEND", "noninteractive")
-                .stdout(std::process::Stdio::null())
-                .status()
-                .is_ok_and(|s| s.success())
-        };
-        let install = ["install", "-y", "-qq", "openimageio-tools"];
-        // A fresh machine may need its package lists first.
-        if apt(&install) || (apt(&["update", "-qq"]) && apt(&install)) {
-            return;
-        }
     }
     println!("note: oiiotool unavailable; the OpenImageIO cross-check will be skipped");
 }
@@ -194,11 +176,7 @@ fn ensure_openimageio() {
 /// must leave a bundle under `P/OFX/Plugins` that a host can load: checked by
 /// listing its plugins through the C ABI with `morphfx plugins`.
 fn cmake_install_check() {
-    let have_cmake = Command::new("cmake")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !have_cmake {
+    if !tools::runs("cmake", &["--version"]) {
         println!("cmake install check: skipped (cmake is not installed)");
         return;
     }

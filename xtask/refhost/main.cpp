@@ -1,0 +1,322 @@
+// morphfx-refhost BUNDLE_DIR: loads MorphFX.ofx.bundle from BUNDLE_DIR with
+// the OpenFX reference host library, then, for each node and each context
+// it must support, creates an instance, checks what the spec mandates in
+// that context, asks for identity where the answer is known, and renders
+// every warp method at render scale 1 and 0.5 in float and 8-bit. Exit
+// status 0 when every check passed, 1 with the failures listed otherwise.
+#include <cmath>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include "refhost.h"
+
+using namespace refhost;
+namespace IE = OFX::Host::ImageEffect;
+
+namespace {
+
+struct Node {
+  const char *id;
+  std::vector<std::string> contexts;
+};
+
+const Node kNodes[] = {
+    {"net.morphfx.Warp",
+     {kOfxImageEffectContextFilter, kOfxImageEffectContextGeneral}},
+    {"net.morphfx.Morph",
+     {kOfxImageEffectContextGeneral, kOfxImageEffectContextTransition}},
+};
+
+std::string statusName(OfxStatus s) {
+  switch (s) {
+    case kOfxStatOK: return "OK";
+    case kOfxStatFailed: return "Failed";
+    case kOfxStatErrFatal: return "ErrFatal";
+    case kOfxStatErrUnknown: return "ErrUnknown";
+    case kOfxStatErrMissingHostFeature: return "ErrMissingHostFeature";
+    case kOfxStatErrUnsupported: return "ErrUnsupported";
+    case kOfxStatErrExists: return "ErrExists";
+    case kOfxStatErrFormat: return "ErrFormat";
+    case kOfxStatErrMemory: return "ErrMemory";
+    case kOfxStatErrBadHandle: return "ErrBadHandle";
+    case kOfxStatErrBadIndex: return "ErrBadIndex";
+    case kOfxStatErrValue: return "ErrValue";
+    case kOfxStatReplyDefault: return "ReplyDefault";
+    default: return "status " + std::to_string(s);
+  }
+}
+
+/// What every check names in its message: node, context, depth, method.
+struct Where {
+  std::string text;
+  Where with(const std::string &more) const { return {text + ", " + more}; }
+};
+
+void expectOk(OfxStatus s, const Where &w, const char *action) {
+  if (s != kOfxStatOK && s != kOfxStatReplyDefault)
+    fail(w.text + ": " + action + " returned " + statusName(s));
+}
+
+/// The clips the spec mandates in `context`, inputs first.
+std::vector<std::string> mandatedClips(const std::string &context) {
+  if (context == kOfxImageEffectContextFilter) return {"Source", "Output"};
+  if (context == kOfxImageEffectContextTransition)
+    return {"SourceFrom", "SourceTo", "Output"};
+  return {"Output"};
+}
+
+std::vector<std::string> inputClips(IE::Instance &fx) {
+  std::vector<std::string> names;
+  for (auto *d : fx.getDescriptor().getClipsByOrder())
+    if (d->getName() != "Output") names.push_back(d->getName());
+  return names;
+}
+
+/// The param that drives the morph's t: the host's in a transition.
+std::string progressParam(const std::string &context) {
+  return context == kOfxImageEffectContextTransition ? "Transition" : "progress";
+}
+
+bool setDouble(IE::Instance &fx, const std::string &name, double v) {
+  auto *p = dynamic_cast<OFX::Host::Param::DoubleInstance *>(fx.getParam(name));
+  return p && p->set(v) == kOfxStatOK;
+}
+
+/// A scene: one more line, and what only a scene can give (the mesh); the
+/// node's own settings win over the scene's.
+void loadScene(IE::Instance &fx, const Where &w) {
+  static const char *scene =
+      "{\"format\": \"morphfx-scene\", \"version\": 1, "
+      " \"features\": [{\"type\": \"line\", \"a\": [[60,50],[80,50]], \"b\": [[62,48],[82,53]]}],"
+      " \"mesh\": {\"rows\": 3, \"cols\": 3,"
+      " \"a\": [[0,0],[48,0],[96,0], [0,32],[48,32],[96,32], [0,64],[48,64],[96,64]],"
+      " \"b\": [[0,0],[48,0],[96,0], [0,32],[56,38],[96,32], [0,64],[48,64],[96,64]]}}";
+  auto *text = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_text"));
+  auto *own = dynamic_cast<OFX::Host::Param::BooleanInstance *>(
+      fx.getParam("settings_from_scene"));
+  if (!text || !own) return fail(w.text + ": no scene_text or settings_from_scene param");
+  text->set(scene);
+  own->set(false);
+}
+
+/// Two line pairs in the line slots: the morph moves something.
+void keyLines(IE::Instance &fx, const Where &w) {
+  const double lines[2][8] = {{20, 20, 70, 22, 26, 28, 76, 24},
+                              {30, 50, 30, 10, 36, 48, 40, 12}};
+  for (int k = 0; k < 2; ++k) {
+    const std::string slot = "line" + std::to_string(k + 1);
+    auto *on = dynamic_cast<OFX::Host::Param::BooleanInstance *>(
+        fx.getParam(slot + "_enable"));
+    if (!on) return fail(w.text + ": no param " + slot + "_enable");
+    on->set(true);
+    const char *ends[4] = {"_a_start", "_a_end", "_b_start", "_b_end"};
+    for (int e = 0; e < 4; ++e) {
+      auto *p = dynamic_cast<OFX::Host::Param::Double2DInstance *>(
+          fx.getParam(slot + ends[e]));
+      if (!p) return fail(w.text + ": no 2D param " + slot + ends[e]);
+      p->set(lines[k][2 * e], lines[k][2 * e + 1]);
+    }
+  }
+}
+
+OfxRectI toPixels(const OfxRectD &r, OfxPointD s) {
+  return {int(std::floor(r.x1 * s.x)), int(std::floor(r.y1 * s.y)),
+          int(std::ceil(r.x2 * s.x)), int(std::ceil(r.y2 * s.y))};
+}
+
+/// Mean RGBA of a render, or nothing when the render failed a check.
+struct Render {
+  bool ok = false;
+  double mean[4] = {0, 0, 0, 0};
+};
+
+/// One frame as a host renders it: region of definition, identity,
+/// begin, regions of interest, render, end. Then the output is read back.
+Render render(Effect &fx, OfxPointD scale, const Where &w) {
+  Render out;
+  const OfxTime t = 0;
+  fx.renderScale = scale;
+  OfxRectD rod;
+  OfxStatus s = fx.getRegionOfDefinitionAction(t, scale, rod);
+  expectOk(s, w, "getRegionOfDefinition");
+  if (s != kOfxStatOK && s != kOfxStatReplyDefault) return out;
+  fx.renderWindow = toPixels(rod, scale);
+  OfxRectI &win = fx.renderWindow;
+  if (win.x2 <= win.x1 || win.y2 <= win.y1) {
+    fail(w.text + ": empty region of definition");
+    return out;
+  }
+  OfxTime idTime = t;
+  std::string idClip;
+  s = fx.isIdentityAction(idTime, kOfxImageFieldNone, win, scale, idClip);
+  if (s == kOfxStatOK) {
+    fail(w.text + ": identity (" + idClip + ") where the morph moves pixels");
+    return out;
+  }
+  expectOk(s, w, "isIdentity");
+  expectOk(fx.beginRenderAction(t, t, 1, false, scale, true, false), w,
+           "beginSequenceRender");
+  fx.regionsOfInterest.clear();
+  expectOk(fx.getRegionOfInterestAction(t, scale, rod, fx.regionsOfInterest), w,
+           "getRegionsOfInterest");
+  fx.persistentError.clear();
+  fx.rendering = true;
+  s = fx.renderAction(t, kOfxImageFieldNone, win, scale, true, false, false);
+  fx.rendering = false;
+  expectOk(fx.endRenderAction(t, t, 1, false, scale, true, false), w,
+           "endSequenceRender");
+  if (s != kOfxStatOK) {
+    fail(w.text + ": render returned " + statusName(s) + " (" +
+         fx.persistentError + ")");
+    return out;
+  }
+  if (!fx.persistentError.empty())
+    fail(w.text + ": render succeeded but left an error: " + fx.persistentError);
+  auto *clip = dynamic_cast<Clip *>(fx.getClip("Output"));
+  if (!clip || !clip->output) {
+    fail(w.text + ": render never fetched the output image");
+    return out;
+  }
+  const Pixels &px = *clip->output;
+  long n = 0;
+  for (int y = win.y1; y < win.y2; ++y)
+    for (int x = win.x1; x < win.x2; ++x, ++n)
+      for (int c = 0; c < 4; ++c) {
+        const float v = px.at(x, y, c);
+        if (!std::isfinite(v) || v < -0.25f || v > 1.25f) {
+          std::ostringstream m;
+          m << w.text << ": output pixel (" << x << ", " << y << ") channel "
+            << c << " is " << v << " (unwritten or out of range)";
+          fail(m.str());
+          return out;
+        }
+        out.mean[c] += v;
+      }
+  for (double &m : out.mean) m /= double(n);
+  out.ok = true;
+  return out;
+}
+
+/// At the ends of the morph the node passes a source through, and says so.
+void checkIdentity(Effect &fx, const std::string &context, const Where &w) {
+  const std::vector<std::string> inputs = inputClips(fx);
+  const bool isMorph = inputs.size() >= 2;
+  const std::string progress = progressParam(context);
+  const OfxPointD scale = {1, 1};
+  fx.renderScale = scale;
+  const OfxRectI win = {0, 0, kProjectWidth, kProjectHeight};
+  struct Case {
+    double t;
+    std::string clip;
+  };
+  std::vector<Case> cases = {{0.0, inputs[0]}};
+  if (isMorph) cases.push_back({1.0, inputs[1]});
+  for (const Case &c : cases) {
+    setDouble(fx, progress, c.t);
+    OfxTime time = 0;
+    std::string clip;
+    const OfxStatus s =
+        fx.isIdentityAction(time, kOfxImageFieldNone, win, scale, clip);
+    std::ostringstream at;
+    at << progress << " = " << c.t;
+    if (s != kOfxStatOK || clip != c.clip || time != 0)
+      fail(w.with(at.str()).text + ": isIdentity answered " + statusName(s) +
+           " '" + clip + "' at time " + std::to_string(time) + ", expected '" +
+           c.clip + "' at time 0");
+  }
+  setDouble(fx, progress, 0.5);
+}
+
+int choiceCount(IE::Instance &fx, const std::string &name) {
+  auto *p = fx.getParam(name);
+  return p ? p->getProperties().getDimension(kOfxParamPropChoiceOption) : 0;
+}
+
+/// One instance of `node` in `context`, its sources at `depth`.
+void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
+                  const std::string &depth, const Where &where) {
+  const Where w = where.with(context).with(depth);
+  std::unique_ptr<IE::Instance> made(plugin.createInstance(context, nullptr));
+  auto *fx = dynamic_cast<Effect *>(made.get());
+  if (!fx) return fail(w.text + ": no instance (describe in context failed)");
+  fx->sourceDepth = depth;
+  for (const std::string &clip : mandatedClips(context))
+    if (!fx->getClip(clip)) fail(w.text + ": mandated clip " + clip + " missing");
+  if (inputClips(*fx).empty()) return fail(w.text + ": no input clip");
+  if (context == kOfxImageEffectContextTransition &&
+      !dynamic_cast<OFX::Host::Param::DoubleInstance *>(fx->getParam("Transition")))
+    return fail(w.text + ": mandated double param Transition missing");
+  keyLines(*fx, w);
+  loadScene(*fx, w);
+  setDouble(*fx, progressParam(context), 0.5);
+  expectOk(fx->createInstanceAction(), w, "createInstance");
+  if (!fx->getClipPreferences()) fail(w.text + ": getClipPreferences failed");
+  checkIdentity(*fx, context, w);
+
+  auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("method"));
+  const int methods = choiceCount(*fx, "method");
+  if (!method || methods < 1) return fail(w.text + ": no method choice");
+  for (int m = 0; m < methods; ++m) {
+    method->set(m);
+    const std::string name = method->getProperties().getStringProperty(
+        kOfxParamPropChoiceOption, m);
+    const Where wm = w.with("method " + name);
+    std::cout << "refhost: " << wm.text << std::endl;
+    const Render full = render(*fx, {1, 1}, wm.with("scale 1"));
+    const Render half = render(*fx, {0.5, 0.5}, wm.with("scale 0.5"));
+    if (!full.ok || !half.ok) continue;
+    // The same picture at half resolution: its mean colour barely moves.
+    for (int c = 0; c < 4; ++c)
+      if (std::fabs(full.mean[c] - half.mean[c]) > 0.03) {
+        std::ostringstream m;
+        m << wm.text << ": channel " << c << " mean " << full.mean[c]
+          << " at scale 1 but " << half.mean[c] << " at scale 0.5";
+        fail(m.str());
+      }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  if (argc != 2) {
+    std::cerr << "usage: morphfx-refhost DIR (the folder holding MorphFX.ofx.bundle)\n";
+    return 2;
+  }
+  OFX::Host::PluginCache::getPluginCache()->setCacheVersion("morphfx-refhost");
+  Host host;
+  IE::PluginCache effects(host);
+  effects.registerInCache(*OFX::Host::PluginCache::getPluginCache());
+  OFX::Host::PluginCache::getPluginCache()->addFileToPath(argv[1]);
+  OFX::Host::PluginCache::getPluginCache()->scanPluginFiles();
+
+  int checked = 0;
+  for (const Node &node : kNodes) {
+    IE::ImageEffectPlugin *plugin = effects.getPluginById(node.id);
+    if (!plugin) {
+      fail(std::string(node.id) + ": not found in " + argv[1]);
+      continue;
+    }
+    const std::set<std::string> &offered = plugin->getContexts();
+    for (const std::string &context : node.contexts) {
+      if (!offered.count(context)) {
+        fail(std::string(node.id) + ": context " + context + " not offered");
+        continue;
+      }
+      for (const char *depth : {kOfxBitDepthFloat, kOfxBitDepthByte}) {
+        checkContext(*plugin, context, depth, {node.id});
+        ++checked;
+      }
+    }
+  }
+  OFX::Host::PluginCache::clearPluginCache();
+
+  if (!failures().empty()) {
+    std::cerr << "refhost: " << failures().size() << " failure(s)\n";
+    return 1;
+  }
+  std::cout << "refhost: " << checked
+            << " node/context/depth combinations passed every check\n";
+  return 0;
+}
