@@ -16,6 +16,30 @@ pub struct Plate {
     pub image: Image,
     /// Width and height of the display window (the canonical frame).
     pub size: (usize, usize),
+    /// Where the display window's top-left corner lies in the file's own
+    /// pixel coordinates (EXR: y grows downwards); 0,0 but in EXRs that say
+    /// otherwise. Canonical coordinates start at the window's bottom-left
+    /// whatever this is, so it only travels from input to output.
+    pub origin: (i32, i32),
+}
+
+impl Plate {
+    /// A plate whose display window starts at the file's origin.
+    pub fn new(image: Image, size: (usize, usize)) -> Plate {
+        Plate {
+            image,
+            size,
+            origin: (0, 0),
+        }
+    }
+}
+
+/// An image file's display window, from its header.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DisplayWindow {
+    pub size: (usize, usize),
+    /// As [`Plate::origin`].
+    pub origin: (i32, i32),
 }
 
 pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
@@ -34,9 +58,10 @@ pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
     }
 }
 
-/// The pixel bounds and display size of an image file, from its header only
-/// (for checking a whole sequence before rendering without reading it twice).
-pub fn probe(path: &Path) -> std::result::Result<(RectI, (usize, usize)), HostError> {
+/// The pixel bounds and display window of an image file, from its header
+/// only (for checking a whole sequence before rendering without reading it
+/// twice).
+pub fn probe(path: &Path) -> std::result::Result<(RectI, DisplayWindow), HostError> {
     if !path.exists() {
         return Err(HostError::bad(format!("{}: no such file", path.display())));
     }
@@ -48,7 +73,11 @@ pub fn probe(path: &Path) -> std::result::Result<(RectI, (usize, usize)), HostEr
         let (w, h) = ::image::image_dimensions(path)
             .map_err(|e| HostError::bad(format!("{}: cannot read image: {e}", path.display())))?;
         let (w, h) = (w as usize, h as usize);
-        return Ok((RectI::from_size(w, h), (w, h)));
+        let window = DisplayWindow {
+            size: (w, h),
+            origin: (0, 0),
+        };
+        return Ok((RectI::from_size(w, h), window));
     }
     let meta = exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| HostError::bad(format!("{}: cannot read EXR: {e}", path.display())))?;
@@ -59,10 +88,11 @@ pub fn probe(path: &Path) -> std::result::Result<(RectI, (usize, usize)), HostEr
     let display = header.shared_attributes.display_window;
     let pos = header.own_attributes.layer_position;
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
-    Ok((
-        data_bounds(display, pos, (w, h)),
-        (display.size.width(), display.size.height()),
-    ))
+    let window = DisplayWindow {
+        size: (display.size.width(), display.size.height()),
+        origin: (display.position.x(), display.position.y()),
+    };
+    Ok((data_bounds(display, pos, (w, h)), window))
 }
 
 /// An EXR data window in canonical pixels: EXR y grows downwards, canonical y
@@ -141,6 +171,7 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
     Ok(Plate {
         image,
         size: (display.size.width(), display.size.height()),
+        origin: (display.position.x(), display.position.y()),
     })
 }
 
@@ -155,10 +186,7 @@ fn read_other(path: &Path) -> std::result::Result<Plate, HostError> {
         let k = (j * w + x as usize) * 4;
         image.data[k..k + 4].copy_from_slice(&p.0);
     }
-    Ok(Plate {
-        image,
-        size: (w, h),
-    })
+    Ok(Plate::new(image, (w, h)))
 }
 
 /// Output sample type of EXR files.
@@ -246,8 +274,9 @@ fn write_exr(
     let err = |e: exr::error::Error| {
         HostError::failed(format!("{}: cannot write EXR: {e}", path.display()))
     };
-    let position = Vec2(b.x1, dh - b.y2);
-    let display = IntegerBounds::new(Vec2(0, 0), Vec2(plate.size.0, plate.size.1));
+    let (ox, oy) = plate.origin;
+    let position = Vec2(ox + b.x1, oy + dh - b.y2);
+    let display = IntegerBounds::new(Vec2(ox, oy), Vec2(plate.size.0, plate.size.1));
     macro_rules! write_with {
         ($conv:expr) => {{
             let channels = SpecificChannels::rgba(move |pos: Vec2<usize>| {

@@ -448,11 +448,18 @@ impl Job {
         // Data windows may differ (overscan, bbox-cropped plates): each is
         // its clip's region of definition, and the Morph node's output
         // covers their union.
+        // The output keeps the first source's display window, frame by frame
+        // (its size is every source's; its origin may move in a sequence).
         let mut first: Option<((usize, usize), String)> = None;
+        let mut windows = std::collections::BTreeMap::new();
         for &f in &frames {
-            for (_, p) in &plates {
+            for (k, (_, p)) in plates.iter().enumerate() {
                 let path = frame_path(&p.pattern, if is_sequence(&p.pattern) { f } else { 0 });
-                let (_, s) = io::probe(&path)?;
+                let (_, window) = io::probe(&path)?;
+                let s = window.size;
+                if k == 0 {
+                    windows.insert(f, window);
+                }
                 let name = path.display().to_string();
                 match &first {
                     None => first = Some((s, name)),
@@ -541,6 +548,7 @@ impl Job {
                     &Plate {
                         image: out.to_image(),
                         size,
+                        origin: windows.get(&f).map_or((0, 0), |w| w.origin),
                     },
                     precision,
                 )?;
@@ -661,10 +669,7 @@ fn bench(
                     &plates.join(format!("{name}.####.exr")).to_string_lossy(),
                     f,
                 ),
-                &Plate {
-                    image,
-                    size: (w, h),
-                },
+                &Plate::new(image, (w, h)),
                 ExrPrecision::Float,
             )?;
         }
@@ -761,18 +766,12 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
     let plates = dir.join("plates");
     io::write(
         &plates.join("a.exr"),
-        &Plate {
-            image: a,
-            size: (w, h),
-        },
+        &Plate::new(a, (w, h)),
         ExrPrecision::Float,
     )?;
     io::write(
         &plates.join("b.exr"),
-        &Plate {
-            image: bb,
-            size: (w, h),
-        },
+        &Plate::new(bb, (w, h)),
         ExrPrecision::Float,
     )?;
     let (cx, cy) = (160.0, 120.0);

@@ -25,7 +25,7 @@ fn tmp(name: &str) -> PathBuf {
 /// Writes `image` as a float EXR in a `size` display window; returns its path.
 fn write_plate(dir: &Path, name: &str, image: Image, size: (usize, usize)) -> String {
     let p = dir.join(name);
-    io::write(&p, &Plate { image, size }, ExrPrecision::Float).unwrap();
+    io::write(&p, &Plate::new(image, size), ExrPrecision::Float).unwrap();
     p.to_string_lossy().into_owned()
 }
 
@@ -286,12 +286,13 @@ fn demo_renders_every_built_method_with_exact_end_frames() {
 }
 
 /// A plate whose data window is `bounds` (canonical, may reach outside the
-/// display window or cover part of it) in a `w × h` display window.
+/// display window or cover part of it) in a `w × h` display window whose
+/// top-left corner lies at `origin` in the file.
 fn windowed_plate(
     dir: &Path,
     name: &str,
     bounds: RectI,
-    size: (usize, usize),
+    (size, origin): ((usize, usize), (i32, i32)),
     seed: f32,
 ) -> (String, Image) {
     let img = Image::from_fn(bounds, 4, |i, j, c| {
@@ -301,15 +302,24 @@ fn windowed_plate(
             0.5 + 0.4 * (i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin()
         }
     });
-    (write_plate(dir, name, img.clone(), size), img)
+    let p = dir.join(name);
+    let plate = Plate {
+        image: img.clone(),
+        size,
+        origin,
+    };
+    io::write(&p, &plate, ExrPrecision::Float).unwrap();
+    (p.to_string_lossy().into_owned(), img)
 }
 
 #[test]
 fn plates_with_other_data_windows_morph_over_the_union_in_the_display_window() {
     let d = tmp("windows");
-    // A: overscan 8 px on every side (negative origin); B: bbox-cropped.
-    let (a, a_img) = windowed_plate(&d, "a.exr", RectI::new(-8, -8, 72, 56), (64, 48), 0.0);
-    let (b, b_img) = windowed_plate(&d, "b.exr", RectI::new(16, 8, 48, 40), (64, 48), 2.0);
+    // A: overscan 8 px on every side (negative origin); B: bbox-cropped;
+    // both display windows away from the file's origin.
+    let window = ((64, 48), (100, 20));
+    let (a, a_img) = windowed_plate(&d, "a.exr", RectI::new(-8, -8, 72, 56), window, 0.0);
+    let (b, b_img) = windowed_plate(&d, "b.exr", RectI::new(16, 8, 48, 40), window, 2.0);
     // A line that stays put: both warps are the identity.
     let still = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
       "features": [{"type": "line", "a": [[10, 10], [40, 12]], "b": [[10, 10], [40, 12]]}]}"#;
@@ -331,6 +341,7 @@ fn plates_with_other_data_windows_morph_over_the_union_in_the_display_window() {
     assert_eq!(code, 0, "{err}");
     let m = io::read(&out).unwrap();
     assert_eq!(m.size, (64, 48), "the display window is kept");
+    assert_eq!(m.origin, (100, 20), "where it lies, too");
     assert_eq!(
         m.image.bounds,
         RectI::new(-8, -8, 72, 56),
@@ -358,7 +369,10 @@ fn plates_with_other_data_windows_morph_over_the_union_in_the_display_window() {
             text.contains("80 x 64, 4 channel"),
             "data window size: {text}"
         );
-        assert!(text.contains("pixel data origin: x=-8, y=-8"), "{text}");
+        // EXR y grows downwards: the data window's top is 8 px above the
+        // display window's, which lies at (100, 20).
+        assert!(text.contains("pixel data origin: x=92, y=12"), "{text}");
         assert!(text.contains("full/display size: 64 x 48"), "{text}");
+        assert!(text.contains("full/display origin: 100, 20"), "{text}");
     }
 }

@@ -21,10 +21,7 @@ fn write_ramp(path: &Path) {
         2 => 0.25,
         _ => 1.0,
     });
-    let plate = Plate {
-        image: img,
-        size: (W, H),
-    };
+    let plate = Plate::new(img, (W, H));
     io::write(path, &plate, ExrPrecision::Float).unwrap();
 }
 

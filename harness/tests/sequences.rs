@@ -30,10 +30,7 @@ fn write_plate(path: &Path, w: usize, h: usize, seed: f32, precision: ExrPrecisi
         let v = ((i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin() + 1.0) * 2.0;
         (v * 256.0).floor() / 256.0
     });
-    let plate = Plate {
-        image: img,
-        size: (w, h),
-    };
+    let plate = Plate::new(img, (w, h));
     io::write(path, &plate, precision).unwrap();
 }
 

@@ -12,15 +12,7 @@ use morphfx_harness::io::{self, ExrPrecision, Plate};
 /// A 96×64 plate with a vertical step edge at canonical x = `edge`.
 fn write_step(path: &Path, edge: f64) {
     let img = morphfx::testing::step_plate(RectI::from_size(96, 64), edge);
-    io::write(
-        path,
-        &Plate {
-            image: img,
-            size: (96, 64),
-        },
-        ExrPrecision::Float,
-    )
-    .unwrap();
+    io::write(path, &Plate::new(img, (96, 64)), ExrPrecision::Float).unwrap();
 }
 
 fn s(p: &Path) -> &str {

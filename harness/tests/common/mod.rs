@@ -51,10 +51,7 @@ pub fn colour_plate(
                 colour(morphfx::geom::Vec2::new(i as f64 + 0.5, j as f64 + 0.5))[c]
             }
         });
-    let plate = Plate {
-        image: image.clone(),
-        size: (w, h),
-    };
+    let plate = Plate::new(image.clone(), (w, h));
     io::write(path, &plate, ExrPrecision::Float).unwrap();
     image
 }
