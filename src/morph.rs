@@ -13,6 +13,11 @@ use crate::warp::WarpMap;
 pub enum Warped<'a, S> {
     Map(&'a Sampler<'a, S>, &'a WarpMap),
     Pixels(&'a Plane),
+    /// A straight-alpha source's warped pixels with colour times alpha, to
+    /// meet premultiplied pixels in a dissolve or a premultiplied output.
+    /// Exactly filtering the premultiplied source: straight sampling already
+    /// weights colour by alpha, and this undoes its division.
+    Premultiplied(&'a Warped<'a, S>),
 }
 
 impl<S: Sample> Warped<'_, S> {
@@ -20,6 +25,7 @@ impl<S: Sample> Warped<'_, S> {
         match self {
             Warped::Map(s, _) => s.channels(),
             Warped::Pixels(p) => p.channels,
+            Warped::Premultiplied(w) => w.channels(),
         }
     }
 
@@ -36,6 +42,16 @@ impl<S: Sample> Warped<'_, S> {
                 if j >= w.y1 && j < w.y2 && lo < hi {
                     let src = &plane.row(j)[(lo - w.x1) as usize..(hi - w.x1) as usize];
                     out[(lo - x1) as usize..(hi - x1) as usize].copy_from_slice(src);
+                }
+            }
+            Warped::Premultiplied(w) => {
+                w.row(j, x1, out);
+                if w.channels() == 4 {
+                    for px in out.iter_mut() {
+                        for c in 0..3 {
+                            px[c] *= px[3];
+                        }
+                    }
                 }
             }
         }

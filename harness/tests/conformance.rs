@@ -417,3 +417,58 @@ fn a_warm_started_thin_plate_matches_a_cold_one_at_another_scale() {
         .fold(0.0f32, f32::max);
     assert!(worst < 1e-3, "warm and cold proxies differ by {worst}");
 }
+
+#[test]
+fn a_straight_source_is_premultiplied_before_it_meets_a_premultiplied_one() {
+    // Semi-transparent plates, A premultiplied and B straight, and a line
+    // that stays put (both warps the identity): the output is declared
+    // premultiplied, so it must be 0.5 A + 0.5 (B's colour times B's alpha).
+    let semi = |seed: f32| {
+        Image::from_fn(RectI::from_size(48, 32), 4, move |i, j, c| {
+            let alpha = 0.5 + 0.5 * (i as f32 * 0.21 + j as f32 * 0.13 + seed).sin();
+            if c == 3 {
+                alpha
+            } else {
+                alpha * (0.5 + 0.4 * (i as f32 * 0.3 + seed + c as f32).cos())
+            }
+        })
+    };
+    let (a, b) = (semi(0.0), semi(1.7));
+    let mut straight_b = Frame::from_image(&b, "OfxBitDepthFloat", false);
+    straight_b.premultiplied = false;
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    inst.set_int("line_count", 1).unwrap();
+    for (id, xy) in [
+        ("line1_a_start", [10.0, 10.0]),
+        ("line1_a_end", [30.0, 12.0]),
+        ("line1_b_start", [10.0, 10.0]),
+        ("line1_b_end", [30.0, 12.0]),
+    ] {
+        inst.set_double(id, &xy, None).unwrap();
+    }
+    inst.set_project(48.0, 32.0);
+    inst.connect("SourceA", still(&a)).unwrap();
+    inst.connect("SourceB", Arc::new(Still(Arc::new(straight_b))))
+        .unwrap();
+    inst.set_double("progress", &[0.5], None).unwrap();
+    let morph = inst.render(1.0, OWN_PIXELS).unwrap().to_image();
+    inst.set_choice("view", "warped-b").unwrap();
+    let warped_b = inst.render(1.0, OWN_PIXELS).unwrap().to_image();
+    for j in 0..32 {
+        for i in 0..48 {
+            let (pa, pb) = (a.pixel(i, j), b.pixel(i, j));
+            let premult_b = [pb[0] * pb[3], pb[1] * pb[3], pb[2] * pb[3], pb[3]];
+            for c in 0..4 {
+                let want = 0.5 * (pa[c] + premult_b[c]);
+                let (m, w) = (morph.pixel(i, j)[c], warped_b.pixel(i, j)[c]);
+                assert!((m - want).abs() < 1e-5, "({i}, {j}) ch {c}: {m} vs {want}");
+                assert!(
+                    (w - premult_b[c]).abs() < 1e-5,
+                    "warped B ({i}, {j}) ch {c}: {w}"
+                );
+            }
+        }
+    }
+}

@@ -5,7 +5,6 @@ use std::sync::{Arc, Mutex};
 
 use morphfx::features::{Feature, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
-use morphfx::image::resample::through;
 use morphfx::image::{EdgeMode, ImageView, Layout, Plane, RowsMut, Sample, Sampler};
 use morphfx::morph::{dissolve, dissolve_weighted, show, Warped};
 use morphfx::scene::{Method, Scene};
@@ -625,10 +624,24 @@ fn prepare<'g>(
             frame.warp.meshes.as_ref()
         },
         planes: &instance.planes,
+        premultiply: premultiply(g),
         scale,
         origin,
         size,
     })
+}
+
+/// Which sources (A, B) are straight but must come out premultiplied: the
+/// output is premultiplied unless every source with an image is straight
+/// (see [`clip_preferences`]), and a dissolve adds like to like.
+fn premultiply(g: &Gathered) -> [bool; 2] {
+    let straight = |s: &Option<(HostImage, ImageInfo)>| s.as_ref().map(|(_, i)| !i.premultiplied);
+    let (a, b) = (straight(&g.a), straight(&g.b));
+    let output_straight = a.unwrap_or(true) && b.unwrap_or(true) && (a.is_some() || b.is_some());
+    [
+        !output_straight && a == Some(true),
+        !output_straight && b == Some(true),
+    ]
 }
 
 /// The canonical rectangle a host image's pixels cover.
@@ -800,6 +813,8 @@ struct Job<'a> {
     meshes: Option<&'a MeshPair>,
     /// Output planes reused between two-pass renders.
     planes: &'a Mutex<Vec<Plane>>,
+    /// Straight sources (A, B) to bring to premultiplied colour.
+    premultiply: [bool; 2],
     scale: PixelScale,
     origin: Vec2,
     size: Vec2,
@@ -816,24 +831,26 @@ impl Job<'_> {
             return self.draw_two_pass(pair, a, b, rows);
         }
         let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
+        let wa = ma.map(|m| Warped::Map(a, m));
+        let wb = b.zip(mb).map(|(b, m)| Warped::Map(b, m));
+        macro_rules! picture {
+            ($w:expr, $side:expr) => {
+                self.in_output_state($w.as_ref().expect("a map for the side drawn"), $side)
+            };
+        }
         match (self.view, b) {
-            (View::Morph, Some(b)) => match &self.weights {
+            (View::Morph, Some(_)) => match &self.weights {
                 Some(w) => dissolve_weighted(
-                    Warped::Map(a, ma.expect("map A")),
-                    Warped::Map(b, mb.expect("map B")),
+                    picture!(wa, Side::A),
+                    picture!(wb, Side::B),
                     self.t,
                     w,
                     rows,
                 ),
-                None => dissolve(
-                    Warped::Map(a, ma.expect("map A")),
-                    Warped::Map(b, mb.expect("map B")),
-                    self.t,
-                    rows,
-                ),
+                None => dissolve(picture!(wa, Side::A), picture!(wb, Side::B), self.t, rows),
             },
-            (View::Morph | View::WarpedA, _) => through(a, ma.expect("map A"), rows),
-            (View::WarpedB, Some(b)) => through(b, mb.expect("map B"), rows),
+            (View::Morph | View::WarpedA, _) => show(picture!(wa, Side::A), rows),
+            (View::WarpedB, Some(_)) => show(picture!(wb, Side::B), rows),
             (View::StmapA, _) => views::stmap(ma.expect("map A"), self.origin, self.size, rows),
             (View::StmapB, _) => {
                 views::stmap(mb.or(ma).expect("map"), self.origin, self.size, rows)
@@ -843,7 +860,18 @@ impl Job<'_> {
                 None => views::transition_grey(&Rates::Uniform(self.t), ma.expect("map A"), rows),
             },
             (View::Grid, _) => views::grid(ma.expect("map A"), self.features, self.t, rows),
-            (View::WarpedB, None) => through(a, ma.expect("map A"), rows),
+            (View::WarpedB, None) => show(picture!(wa, Side::A), rows),
+        }
+    }
+
+    /// `w` as the output holds colour: premultiplied when `side` is straight
+    /// and the output is not.
+    fn in_output_state<'w, S: Sample>(&self, w: &'w Warped<'w, S>, side: Side) -> Warped<'w, S> {
+        let k = if side == Side::A { 0 } else { 1 };
+        if self.premultiply[k] {
+            Warped::Premultiplied(w)
+        } else {
+            *w
         }
     }
 
@@ -881,9 +909,10 @@ impl Job<'_> {
                     (self.t < 1.0).then(|| plane(Side::A, a)).flatten(),
                     (self.t > 0.0).then(|| plane(Side::B, b)).flatten(),
                 );
+                let (wa, wb) = (warped(a, &pa, &identity), warped(b, &pb, &identity));
                 dissolve(
-                    warped(a, &pa, &identity),
-                    warped(b, &pb, &identity),
+                    self.in_output_state(&wa, Side::A),
+                    self.in_output_state(&wb, Side::B),
                     self.t,
                     rows,
                 );
@@ -891,12 +920,18 @@ impl Job<'_> {
             }
             (View::WarpedB, Some(b)) => {
                 let p = plane(Side::B, b);
-                show(warped(b, &p, &identity), rows);
+                show(
+                    self.in_output_state(&warped(b, &p, &identity), Side::B),
+                    rows,
+                );
                 [p, None]
             }
             _ => {
                 let p = plane(Side::A, a);
-                show(warped(a, &p, &identity), rows);
+                show(
+                    self.in_output_state(&warped(a, &p, &identity), Side::A),
+                    rows,
+                );
                 [p, None]
             }
         };
