@@ -472,3 +472,35 @@ fn a_straight_source_is_premultiplied_before_it_meets_a_premultiplied_one() {
         }
     }
 }
+
+/// A still whose clip reports an infinite region of definition (a constant
+/// or a Roto upstream) while its images hold the plate's pixels.
+struct Unbounded(Arc<Frame>);
+
+impl FrameSource for Unbounded {
+    fn frame(&self, _: f64) -> Result<Arc<Frame>, String> {
+        Ok(self.0.clone())
+    }
+    fn infinite(&self) -> bool {
+        true
+    }
+}
+
+#[test]
+fn an_infinite_source_region_renders_the_same_pixels_in_the_project() {
+    let a = plate(64, 48, 0.0);
+    let render = |source: Arc<dyn FrameSource>| {
+        let inst = bundle()
+            .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
+            .unwrap();
+        key_one_line(&inst);
+        inst.set_project(64.0, 48.0);
+        inst.connect("Source", source).unwrap();
+        inst.render(1.0, OWN_PIXELS).unwrap().to_image()
+    };
+    let frame = Arc::new(Frame::from_image(&a, "OfxBitDepthFloat", false));
+    let finite = render(Arc::new(Still(frame.clone())));
+    let infinite = render(Arc::new(Unbounded(frame)));
+    assert_eq!(infinite.bounds, RectI::from_size(64, 48), "the project");
+    assert_eq!(infinite.data, finite.data);
+}

@@ -19,7 +19,21 @@ use super::props::PropertySet;
 pub trait FrameSource: Send + Sync {
     /// The frame at `time` at render scale 1, or why there is none.
     fn frame(&self, time: f64) -> Result<Arc<Frame>, String>;
+
+    /// Whether the clip's region of definition is infinite (the spec allows
+    /// it: a constant or a Roto upstream) while its images stay finite.
+    fn infinite(&self) -> bool {
+        false
+    }
 }
+
+/// The spec's infinite region (`kOfxFlagInfiniteMin` to `kOfxFlagInfiniteMax`).
+pub const INFINITE: RectI = RectI {
+    x1: i32::MIN,
+    y1: i32::MIN,
+    x2: i32::MAX,
+    y2: i32::MAX,
+};
 
 pub struct Clip {
     pub name: String,
@@ -290,6 +304,9 @@ impl Clip {
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .clone()?;
+        if source.infinite() {
+            return Some(INFINITE);
+        }
         source.frame(time).ok().map(|f| f.bounds)
     }
 }

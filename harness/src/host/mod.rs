@@ -628,6 +628,29 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// The project's images (size at offset), canonical, rounded out.
+    fn project_rect(&self) -> RectI {
+        let p = &self.effect.props;
+        let (size, offset) = (
+            p.doubles(kOfxImageEffectPropProjectSize),
+            p.doubles(kOfxImageEffectPropProjectOffset),
+        );
+        let (w, h) = (
+            size.first().copied().unwrap_or(0.0),
+            size.get(1).copied().unwrap_or(0.0),
+        );
+        let (x, y) = (
+            offset.first().copied().unwrap_or(0.0),
+            offset.get(1).copied().unwrap_or(0.0),
+        );
+        RectI::new(
+            x.floor() as i32,
+            y.floor() as i32,
+            (x + w).ceil() as i32,
+            (y + h).ceil() as i32,
+        )
+    }
+
     pub fn set_project(&self, width: f64, height: f64) {
         self.set_letterboxed_project((width, height), (0.0, 0.0), (width, height));
     }
@@ -780,6 +803,12 @@ impl Instance<'_> {
             .lock()
             .unwrap_or_else(|e| e.into_inner()) = spec.render_scale;
         let rod = self.region_of_definition(time, spec.render_scale)?;
+        // An infinite region is rendered where a viewer shows it: the project.
+        let rod = if rod.x1 <= i32::MIN / 2 || rod.x2 >= i32::MAX / 2 {
+            rod.intersect(&self.project_rect())
+        } else {
+            rod
+        };
         let (sx, sy) = spec.render_scale;
         let bounds = RectI::new(
             (rod.x1 as f64 * sx).floor() as i32,
