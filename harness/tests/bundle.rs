@@ -607,6 +607,9 @@ fn snap_lines_keys_each_side_onto_its_own_edge_at_the_current_frame() {
         assert_eq!(log.last().map(String::as_str), Some("end"), "{log:?}");
         assert_eq!(log.len(), 6, "begin, four keys at frame 7, end: {log:?}");
         assert!(log[1..5].iter().all(|e| e.ends_with("@7")), "{log:?}");
+        // Written from the instance-changed action, the one place allowed.
+        let seen = morphfx_harness::host::take_violations();
+        assert!(!seen.iter().any(|v| v.contains("param line1")), "{seen:?}");
         for (id, edge) in [
             ("line1_a_start", 24.0),
             ("line1_a_end", 24.0),

@@ -296,6 +296,7 @@ impl Bundle {
         out_args: Option<&PropertySet>,
     ) -> OfxStatus {
         let h = |p: Option<&PropertySet>| p.map_or(std::ptr::null_mut(), |p| p.handle());
+        let _inside = params::Inside::action(action);
         // SAFETY: `plugin` came from this bundle's OfxGetPlugin and the library
         // is loaded; handles are live objects of this host.
         unsafe {

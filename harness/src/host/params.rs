@@ -333,6 +333,41 @@ thread_local! {
         const { std::cell::RefCell::new((0, Vec::new())) };
 }
 
+thread_local! {
+    /// The action the host is calling on this thread, innermost last.
+    static ACTIONS: std::cell::RefCell<Vec<String>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Marks this thread as inside `action` until dropped: the spec lets a
+/// plugin set param values only from the instance-changed action (and
+/// interacts), so a write anywhere else is a violation.
+pub struct Inside;
+
+impl Inside {
+    pub fn action(action: &CStr) -> Inside {
+        ACTIONS.with(|a| a.borrow_mut().push(action.to_string_lossy().into_owned()));
+        Inside
+    }
+}
+
+impl Drop for Inside {
+    fn drop(&mut self) {
+        ACTIONS.with(|a| a.borrow_mut().pop());
+    }
+}
+
+/// Reports a param write made outside the instance-changed action (a
+/// render, a thread of the plugin's own, another action).
+fn check_write_allowed(param: &str) {
+    let action = ACTIONS.with(|a| a.borrow().last().cloned());
+    if action.as_deref() != Some("OfxActionInstanceChanged") {
+        super::violation(format!(
+            "param {param} written in {} (only the instance-changed action may set values)",
+            action.as_deref().unwrap_or("a thread outside any action")
+        ));
+    }
+}
+
 /// What the plugin wrote on this thread since the last call: `begin NAME`,
 /// `set PARAM` or `set PARAM@TIME`, `end`.
 pub fn take_edit_log() -> Vec<String> {
@@ -459,6 +494,7 @@ pub unsafe extern "C" fn mfx_param_set(
             v.s = CStr::from_ptr(s).to_owned();
         }
     }
+    check_write_allowed(&p.name);
     if at_time != 0 {
         log_edit(format!("set {}@{time}", p.name));
         p.set_key(time, v);
@@ -498,3 +534,52 @@ pub static SUITE: OfxParameterSuiteV1 = OfxParameterSuiteV1 {
     paramEditBegin: Some(edit_begin),
     paramEditEnd: Some(edit),
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(param: &Param) {
+        let (d, i) = ([0.5f64; 4], [0 as c_int; 4]);
+        // SAFETY: the handle is a live Param; the arrays hold 4 values.
+        let st = unsafe {
+            mfx_param_set(
+                param as *const Param as OfxParamHandle,
+                0.0,
+                0,
+                d.as_ptr(),
+                i.as_ptr(),
+                std::ptr::null(),
+            )
+        };
+        assert_eq!(st, kOfxStatOK);
+    }
+
+    fn reported(name: &str) -> bool {
+        super::super::take_violations()
+            .iter()
+            .any(|v| v.contains(&format!("param {name} ")))
+    }
+
+    #[test]
+    fn param_writes_outside_instance_changed_are_violations() {
+        let param = Param {
+            name: "written_param".into(),
+            kind: "OfxParamTypeDouble".into(),
+            props: PropertySet::new(),
+            state: Mutex::new(Default::default()),
+        };
+        {
+            let _in = Inside::action(c"OfxActionInstanceChanged");
+            write(&param);
+        }
+        assert!(!reported("written_param"), "allowed in instance changed");
+        {
+            let _in = Inside::action(c"OfxImageEffectActionRender");
+            write(&param);
+        }
+        assert!(reported("written_param"), "a write during a render");
+        write(&param);
+        assert!(reported("written_param"), "a write outside any action");
+    }
+}
