@@ -504,3 +504,39 @@ fn an_infinite_source_region_renders_the_same_pixels_in_the_project() {
     assert_eq!(infinite.bounds, RectI::from_size(64, 48), "the project");
     assert_eq!(infinite.data, finite.data);
 }
+
+#[test]
+fn anamorphic_pixels_move_by_canonical_distance_over_the_pixel_aspect() {
+    // Pixels twice as wide as tall: one line pair moved 10 canonical units
+    // right (a pure translation for a single line) moves the picture 5 px.
+    let a = plate(64, 48, 0.0);
+    let mut frame = Frame::from_image(&a, "OfxBitDepthFloat", false);
+    frame.par = 2.0;
+    let inst = bundle()
+        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
+        .unwrap();
+    inst.set_pixel_aspect(2.0);
+    inst.set_project(128.0, 48.0);
+    inst.set_int("line_count", 1).unwrap();
+    for (id, xy) in [
+        ("line1_a_start", [40.0, 10.0]),
+        ("line1_a_end", [80.0, 30.0]),
+        ("line1_b_start", [50.0, 10.0]),
+        ("line1_b_end", [90.0, 30.0]),
+    ] {
+        inst.set_double(id, &xy, None).unwrap();
+    }
+    inst.set_double("progress", &[1.0], None).unwrap();
+    inst.connect("Source", Arc::new(Still(Arc::new(frame))))
+        .unwrap();
+    let out = inst.render(1.0, OWN_PIXELS).unwrap().to_image();
+    assert_eq!(out.bounds, RectI::from_size(64, 48), "64 pixels, 128 units");
+    for j in 0..48 {
+        for i in 5..64 {
+            for c in 0..4 {
+                let (o, s) = (out.pixel(i, j)[c], a.pixel(i - 5, j)[c]);
+                assert!((o - s).abs() < 1e-4, "({i}, {j}) ch {c}: {o} vs {s}");
+            }
+        }
+    }
+}

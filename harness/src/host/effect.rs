@@ -307,7 +307,12 @@ impl Clip {
         if source.infinite() {
             return Some(INFINITE);
         }
-        source.frame(time).ok().map(|f| f.bounds)
+        // Canonical x is pixels times the pixel aspect ratio.
+        source.frame(time).ok().map(|f| {
+            let b = f.bounds;
+            let x = |v: i32| (v as f64 * f.par).round() as i32;
+            RectI::new(x(b.x1), b.y1, x(b.x2), b.y2)
+        })
     }
 }
 

@@ -26,6 +26,8 @@ pub struct Frame {
     /// Rows stored top-down, handed out with negative row bytes.
     pub top_down: bool,
     pub premultiplied: bool,
+    /// Pixel aspect ratio: a pixel is `par` canonical units wide.
+    pub par: f64,
 }
 
 // SAFETY: plugins write to the output frame through raw pointers from render
@@ -59,6 +61,7 @@ impl Frame {
             pixels: std::cell::UnsafeCell::new(pixels),
             top_down,
             premultiplied: true,
+            par: 1.0,
         }
     }
 
@@ -132,6 +135,7 @@ impl Frame {
         });
         let mut f = Frame::from_image(&img, self.depth(), self.top_down);
         f.premultiplied = self.premultiplied;
+        f.par = self.par;
         f
     }
 
@@ -197,7 +201,7 @@ impl Frame {
                 "OfxImagePreMultiplied"
             },
         );
-        p.set_double(kOfxImagePropPixelAspectRatio, &[1.0]);
+        p.set_double(kOfxImagePropPixelAspectRatio, &[self.par]);
         p.set_double(kOfxImageEffectPropRenderScale, &[scale.0, scale.1]);
         p.set_str(kOfxImagePropField, "OfxImageFieldNone");
         p.set_str(

@@ -629,6 +629,26 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// Anamorphic footage: pixels `par` canonical units wide, for the project
+    /// and every clip (connect frames with the same `par`).
+    pub fn set_pixel_aspect(&self, par: f64) {
+        self.effect
+            .props
+            .set_double(kOfxImageEffectPropProjectPixelAspectRatio, &[par]);
+        let clips = self.effect.clips.lock().unwrap_or_else(|e| e.into_inner());
+        for clip in clips.iter() {
+            clip.props.set_double(kOfxImagePropPixelAspectRatio, &[par]);
+        }
+    }
+
+    fn pixel_aspect(&self) -> f64 {
+        let par = self
+            .effect
+            .props
+            .doubles(kOfxImageEffectPropProjectPixelAspectRatio);
+        par.first().copied().filter(|p| *p > 0.0).unwrap_or(1.0)
+    }
+
     /// The project's images (size at offset), canonical, rounded out.
     fn project_rect(&self) -> RectI {
         let p = &self.effect.props;
@@ -810,7 +830,9 @@ impl Instance<'_> {
         } else {
             rod
         };
-        let (sx, sy) = spec.render_scale;
+        // Pixels: canonical x divided by the pixel aspect ratio.
+        let par = self.pixel_aspect();
+        let (sx, sy) = (spec.render_scale.0 / par, spec.render_scale.1);
         let bounds = RectI::new(
             (rod.x1 as f64 * sx).floor() as i32,
             (rod.y1 as f64 * sy).floor() as i32,
@@ -834,12 +856,9 @@ impl Instance<'_> {
                 )));
             }
         }
-        let out = Arc::new(Frame::blank(
-            bounds,
-            spec.channels,
-            spec.depth,
-            spec.top_down,
-        ));
+        let mut out = Frame::blank(bounds, spec.channels, spec.depth, spec.top_down);
+        out.par = par;
+        let out = Arc::new(out);
         let out_clip = self
             .effect
             .clip("Output")
