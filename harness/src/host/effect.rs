@@ -3,6 +3,7 @@
 
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr};
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 
 use morphfx::geom::RectI;
@@ -360,11 +361,32 @@ unsafe extern "C" fn clip_release_image(image: OfxPropertySetHandle) -> OfxStatu
     if image.is_null() {
         return kOfxStatErrBadHandle;
     }
-    // SAFETY: image handles come only from Box::into_raw in clip_get_image,
-    // and a plugin releases each once.
-    drop(unsafe { Box::from_raw(image as *mut PropertySet) });
+    // SAFETY: image handles come only from Box::into_raw in clip_get_image
+    // and are never freed (see below), so the set is live.
+    let set = unsafe { &*(image as *const PropertySet) };
+    if set.released.swap(true, Ordering::Relaxed) {
+        super::violation("an image released twice".into());
+        return kOfxStatErrBadHandle;
+    }
+    // The pixels go now; the emptied set stays, so a later use is reported
+    // (by the property suite) instead of reading freed memory.
+    // SAFETY: as above; the plugin gave up the handle with this call, and
+    // only this function (once per image, checked above) takes the box back.
+    let mut set = unsafe { Box::from_raw(image as *mut PropertySet) };
+    set.owner = None;
+    set.clear();
+    RELEASED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(SendSet(set));
     kOfxStatOK
 }
+
+/// Released images' emptied property sets, kept for the life of the process
+/// (a few dozen bytes each).
+static RELEASED: Mutex<Vec<SendSet>> = Mutex::new(Vec::new());
+
+struct SendSet(#[allow(dead_code)] Box<PropertySet>);
 
 unsafe extern "C" fn clip_get_rod(
     clip: OfxImageClipHandle,
@@ -521,3 +543,47 @@ pub static MESSAGE_SUITE_V2: OfxMessageSuiteV2 = OfxMessageSuiteV2 {
     setPersistentMessage: Some(mfx_persistent_message),
     clearPersistentMessage: Some(clear_persistent),
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_image_used_after_release_is_a_violation_not_a_crash() {
+        let _one_at_a_time = super::super::VIOLATION_TESTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let set = PropertySet::new();
+        set.set_int(kOfxImagePropRowBytes, &[256]);
+        let h = Box::into_raw(Box::new(set)) as OfxPropertySetHandle;
+        let (get, release) = (
+            super::super::props::SUITE.propGetInt.unwrap(),
+            SUITE.clipReleaseImage.unwrap(),
+        );
+        let mut rb = 0;
+        // SAFETY: `h` is a live set made above; the out-pointer is ours.
+        assert_eq!(
+            unsafe { get(h, kOfxImagePropRowBytes.as_ptr(), 0, &mut rb) },
+            kOfxStatOK
+        );
+        assert_eq!(rb, 256);
+        // SAFETY: as above; the host keeps released sets, so these calls are sound.
+        unsafe {
+            assert_eq!(release(h), kOfxStatOK);
+            assert_ne!(
+                get(h, kOfxImagePropRowBytes.as_ptr(), 0, &mut rb),
+                kOfxStatOK
+            );
+            assert_eq!(release(h), kOfxStatErrBadHandle);
+        }
+        let seen = super::super::take_violations();
+        assert!(
+            seen.iter().any(|v| v.contains("after clipReleaseImage")),
+            "{seen:?}"
+        );
+        assert!(
+            seen.iter().any(|v| v.contains("released twice")),
+            "{seen:?}"
+        );
+    }
+}

@@ -83,6 +83,10 @@ pub fn violation(what: String) {
         .push(what);
 }
 
+/// Held by unit tests that read [`take_violations`], which is process-wide.
+#[cfg(test)]
+pub(crate) static VIOLATION_TESTS: Mutex<()> = Mutex::new(());
+
 /// The spec violations seen so far in this process (taken).
 pub fn take_violations() -> Vec<String> {
     std::mem::take(&mut *VIOLATIONS.lock().unwrap_or_else(|e| e.into_inner()))

@@ -563,6 +563,9 @@ mod tests {
 
     #[test]
     fn param_writes_outside_instance_changed_are_violations() {
+        let _one_at_a_time = super::super::VIOLATION_TESTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
         let param = Param {
             name: "written_param".into(),
             kind: "OfxParamTypeDouble".into(),

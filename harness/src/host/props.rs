@@ -22,6 +22,9 @@ pub struct PropertySet {
     values: Mutex<HashMap<String, Value>>,
     /// Keeps whatever the set describes alive (an image's pixels).
     pub owner: Option<Box<dyn Any + Send + Sync>>,
+    /// An image's set after `clipReleaseImage`: kept (emptied) so that a
+    /// plugin still using it is reported, not undefined behaviour.
+    pub released: std::sync::atomic::AtomicBool,
 }
 
 impl PropertySet {
@@ -88,8 +91,12 @@ impl PropertySet {
     pub fn clone_values(&self) -> PropertySet {
         PropertySet {
             values: Mutex::new(self.map().clone()),
-            owner: None,
+            ..PropertySet::default()
         }
+    }
+    /// Forgets every value.
+    pub fn clear(&self) {
+        self.map().clear();
     }
     pub fn handle(&self) -> OfxPropertySetHandle {
         self as *const PropertySet as OfxPropertySetHandle
@@ -100,8 +107,14 @@ impl PropertySet {
 /// `h` must be null or a handle this host made from a live `PropertySet`.
 unsafe fn set_of<'a>(h: OfxPropertySetHandle) -> Option<&'a PropertySet> {
     // SAFETY: per the contract above; every property set handle we hand out
-    // points at a PropertySet that outlives the plugin's use of it.
-    unsafe { (h as *const PropertySet).as_ref() }
+    // points at a PropertySet that outlives the plugin's use of it (released
+    // images' sets are kept).
+    let set = unsafe { (h as *const PropertySet).as_ref() }?;
+    if set.released.load(std::sync::atomic::Ordering::Relaxed) {
+        super::violation("an image's properties read or written after clipReleaseImage".into());
+        return None;
+    }
+    Some(set)
 }
 
 fn name_of(p: *const c_char) -> Option<String> {
