@@ -836,11 +836,11 @@ impl Instance<'_> {
         };
         // Pixels: canonical x divided by the pixel aspect ratio.
         let par = self.pixel_aspect();
-        let (sx, sy) = (spec.render_scale.0 / par, spec.render_scale.1);
+        let (sx, sy) = spec.render_scale;
         let bounds = RectI::new(
-            (rod.x1 as f64 * sx).floor() as i32,
+            (rod.x1 as f64 * sx / par).floor() as i32,
             (rod.y1 as f64 * sy).floor() as i32,
-            (rod.x2 as f64 * sx).ceil() as i32,
+            (rod.x2 as f64 * sx / par).ceil() as i32,
             (rod.y2 as f64 * sy).ceil() as i32,
         );
         if spec.identity {
