@@ -64,6 +64,11 @@ pub struct Effect {
     pub messages: Mutex<Vec<Message>>,
     /// (render scale x, y) of the render in progress.
     pub render_scale: Mutex<(f64, f64)>,
+    /// The field of the render in progress (`OfxImageFieldNone` for
+    /// progressive footage): source images are that field, lines doubled.
+    pub field: Mutex<&'static str>,
+    /// Interlaced footage: the clips' field order (which field comes first).
+    pub field_order: Mutex<Option<&'static str>>,
     /// The time line as this effect sees it: (current, first, last).
     pub timeline: Mutex<(f64, f64, f64)>,
     /// Progress the plugin last reported (progress suite), if a task is open.
@@ -83,6 +88,8 @@ impl Effect {
             clips: Mutex::new(Vec::new()),
             messages: Mutex::new(Vec::new()),
             render_scale: Mutex::new((1.0, 1.0)),
+            field: Mutex::new("OfxImageFieldNone"),
+            field_order: Mutex::new(None),
             timeline: Mutex::new((0.0, 0.0, 0.0)),
             progress: Mutex::new(None),
             persistent: Mutex::new(None),
@@ -285,7 +292,16 @@ impl Clip {
         let Some(source) = source else {
             return Ok(None);
         };
-        let frame = source.frame(time)?;
+        let mut frame = source.frame(time)?;
+        // The spec's default extraction: one field, each line doubled.
+        let field = *self
+            .effect()
+            .field
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        if matches!(field, "OfxImageFieldLower" | "OfxImageFieldUpper") {
+            frame = Arc::new(frame.field_doubled(field == "OfxImageFieldUpper"));
+        }
         let scale = *self
             .effect()
             .render_scale

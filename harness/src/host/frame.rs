@@ -99,6 +99,21 @@ impl Frame {
         }
     }
 
+    /// One field of an interlaced frame, each of its lines doubled: the
+    /// lower field is lines 0, 2, 4, ... (y up), the upper 1, 3, 5, ...
+    pub fn field_doubled(&self, upper: bool) -> Frame {
+        let src = self.to_image();
+        let b = self.bounds;
+        let img = Image::from_fn(b, self.channels, |i, j, c| {
+            let line = (j - j.rem_euclid(2) + upper as i32).clamp(b.y1, b.y2 - 1);
+            src.pixel(i, line)[c]
+        });
+        let mut f = Frame::from_image(&img, self.depth(), self.top_down);
+        f.premultiplied = self.premultiplied;
+        f.par = self.par;
+        f
+    }
+
     /// A box-filtered copy at render scale `scale` (proxy renders).
     pub fn scaled(&self, scale: (f64, f64)) -> Frame {
         let src = self.to_image();
