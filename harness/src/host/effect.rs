@@ -391,16 +391,21 @@ unsafe extern "C" fn clip_release_image(image: OfxPropertySetHandle) -> OfxStatu
     let mut set = unsafe { Box::from_raw(image as *mut PropertySet) };
     set.owner = None;
     set.clear();
-    RELEASED
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .push(SendSet(set));
+    let mut released = RELEASED.lock().unwrap_or_else(|e| e.into_inner());
+    if released.len() == RELEASED_KEPT {
+        // A long render stays flat in memory: the oldest shells go (a
+        // plugin misusing an image does so within a frame or two).
+        released.pop_front();
+    }
+    released.push_back(SendSet(set));
     kOfxStatOK
 }
 
-/// Released images' emptied property sets, kept for the life of the process
-/// (a few dozen bytes each).
-static RELEASED: Mutex<Vec<SendSet>> = Mutex::new(Vec::new());
+/// Released images' emptied property sets (a few dozen bytes each), the
+/// newest [`RELEASED_KEPT`].
+static RELEASED: Mutex<std::collections::VecDeque<SendSet>> =
+    Mutex::new(std::collections::VecDeque::new());
+const RELEASED_KEPT: usize = 1 << 16;
 
 struct SendSet(#[allow(dead_code)] Box<PropertySet>);
 

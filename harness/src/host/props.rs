@@ -94,9 +94,9 @@ impl PropertySet {
             ..PropertySet::default()
         }
     }
-    /// Forgets every value.
+    /// Forgets every value, and the memory that held them.
     pub fn clear(&self) {
-        self.map().clear();
+        *self.map() = HashMap::new();
     }
     pub fn handle(&self) -> OfxPropertySetHandle {
         self as *const PropertySet as OfxPropertySetHandle
