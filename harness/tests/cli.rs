@@ -24,8 +24,13 @@ fn tmp(name: &str) -> PathBuf {
 
 /// Writes `image` as a float EXR in a `size` display window; returns its path.
 fn write_plate(dir: &Path, name: &str, image: Image, size: (usize, usize)) -> String {
+    write_exr(dir, name, &Plate::new(image, size))
+}
+
+/// Writes `plate` as a float EXR; returns its path.
+fn write_exr(dir: &Path, name: &str, plate: &Plate) -> String {
     let p = dir.join(name);
-    io::write(&p, &Plate::new(image, size), ExrPrecision::Float).unwrap();
+    io::write(&p, plate, ExrPrecision::Float).unwrap();
     p.to_string_lossy().into_owned()
 }
 
@@ -302,14 +307,12 @@ fn windowed_plate(
             0.5 + 0.4 * (i as f32 * 0.37 + j as f32 * 0.11 + seed + c as f32).sin()
         }
     });
-    let p = dir.join(name);
     let plate = Plate {
         image: img.clone(),
         size,
         origin,
     };
-    io::write(&p, &plate, ExrPrecision::Float).unwrap();
-    (p.to_string_lossy().into_owned(), img)
+    (write_exr(dir, name, &plate), img)
 }
 
 #[test]

@@ -45,12 +45,21 @@ fn still(img: &Image) -> Arc<Still> {
 
 /// One line pair moving, so every in-between differs from both sources.
 fn key_one_line(inst: &host::Instance<'_>) {
+    key_line(
+        inst,
+        [[10.0, 10.0], [50.0, 14.0]],
+        [[16.0, 6.0], [55.0, 20.0]],
+    );
+}
+
+/// The only line pair: from `a` (start, end) on A to `b` on B.
+fn key_line(inst: &host::Instance<'_>, a: [[f64; 2]; 2], b: [[f64; 2]; 2]) {
     inst.set_int("line_count", 1).unwrap();
     for (id, xy) in [
-        ("line1_a_start", [10.0, 10.0]),
-        ("line1_a_end", [50.0, 14.0]),
-        ("line1_b_start", [16.0, 6.0]),
-        ("line1_b_end", [55.0, 20.0]),
+        ("line1_a_start", a[0]),
+        ("line1_a_end", a[1]),
+        ("line1_b_start", b[0]),
+        ("line1_b_end", b[1]),
     ] {
         inst.set_double(id, &xy, None).unwrap();
     }
@@ -385,15 +394,11 @@ fn a_warm_started_thin_plate_matches_a_cold_one_at_another_scale() {
             .unwrap();
         // One horizontal line, its ends moving apart vertically: the plates
         // were free to tilt about it.
-        inst.set_int("line_count", 1).unwrap();
-        for (id, xy) in [
-            ("line1_a_start", [60.0, 50.0]),
-            ("line1_a_end", [80.0, 50.0]),
-            ("line1_b_start", [62.0, 48.0]),
-            ("line1_b_end", [82.0, 53.0]),
-        ] {
-            inst.set_double(id, &xy, None).unwrap();
-        }
+        key_line(
+            &inst,
+            [[60.0, 50.0], [80.0, 50.0]],
+            [[62.0, 48.0], [82.0, 53.0]],
+        );
         inst.set_int("method", 3).unwrap(); // thin-plate
         inst.set_project(96.0, 64.0);
         inst.connect("Source", still(&a)).unwrap();
@@ -439,15 +444,11 @@ fn a_straight_source_is_premultiplied_before_it_meets_a_premultiplied_one() {
     let inst = bundle()
         .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
         .unwrap();
-    inst.set_int("line_count", 1).unwrap();
-    for (id, xy) in [
-        ("line1_a_start", [10.0, 10.0]),
-        ("line1_a_end", [30.0, 12.0]),
-        ("line1_b_start", [10.0, 10.0]),
-        ("line1_b_end", [30.0, 12.0]),
-    ] {
-        inst.set_double(id, &xy, None).unwrap();
-    }
+    key_line(
+        &inst,
+        [[10.0, 10.0], [30.0, 12.0]],
+        [[10.0, 10.0], [30.0, 12.0]],
+    );
     inst.set_project(48.0, 32.0);
     inst.connect("SourceA", still(&a)).unwrap();
     inst.connect("SourceB", Arc::new(Still(Arc::new(straight_b))))
@@ -517,15 +518,11 @@ fn anamorphic_pixels_move_by_canonical_distance_over_the_pixel_aspect() {
         .unwrap();
     inst.set_pixel_aspect(2.0);
     inst.set_project(128.0, 48.0);
-    inst.set_int("line_count", 1).unwrap();
-    for (id, xy) in [
-        ("line1_a_start", [40.0, 10.0]),
-        ("line1_a_end", [80.0, 30.0]),
-        ("line1_b_start", [50.0, 10.0]),
-        ("line1_b_end", [90.0, 30.0]),
-    ] {
-        inst.set_double(id, &xy, None).unwrap();
-    }
+    key_line(
+        &inst,
+        [[40.0, 10.0], [80.0, 30.0]],
+        [[50.0, 10.0], [90.0, 30.0]],
+    );
     inst.set_double("progress", &[1.0], None).unwrap();
     inst.connect("Source", Arc::new(Still(Arc::new(frame))))
         .unwrap();
@@ -552,15 +549,11 @@ fn interlaced_footage_is_warped_one_field_at_a_time() {
         .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
         .unwrap();
     inst.set_project(64.0, 48.0);
-    inst.set_int("line_count", 1).unwrap();
-    for (id, xy) in [
-        ("line1_a_start", [10.0, 10.0]),
-        ("line1_a_end", [50.0, 30.0]),
-        ("line1_b_start", [10.0, 13.0]),
-        ("line1_b_end", [50.0, 33.0]),
-    ] {
-        inst.set_double(id, &xy, None).unwrap();
-    }
+    key_line(
+        &inst,
+        [[10.0, 10.0], [50.0, 30.0]],
+        [[10.0, 13.0], [50.0, 33.0]],
+    );
     inst.set_double("progress", &[1.0], None).unwrap();
     inst.connect("Source", still(&a)).unwrap();
     inst.set_field_order("OfxImageFieldLower");

@@ -120,11 +120,6 @@ void keyLines(IE::Instance &fx, const Where &w) {
   }
 }
 
-OfxRectI toPixels(const OfxRectD &r, OfxPointD s) {
-  return {int(std::floor(r.x1 * s.x)), int(std::floor(r.y1 * s.y)),
-          int(std::ceil(r.x2 * s.x)), int(std::ceil(r.y2 * s.y))};
-}
-
 /// Mean RGBA of a render, or nothing when the render failed a check.
 struct Render {
   bool ok = false;

@@ -386,7 +386,7 @@ OfxRectD Clip::getRegionOfDefinition(OfxTime) const {
   return r;
 }
 
-static OfxRectI toPixels(const OfxRectD &r, OfxPointD scale) {
+OfxRectI toPixels(const OfxRectD &r, OfxPointD scale) {
   OfxRectI p = {int(std::floor(r.x1 * scale.x)), int(std::floor(r.y1 * scale.y)),
                 int(std::ceil(r.x2 * scale.x)), int(std::ceil(r.y2 * scale.y))};
   return p;

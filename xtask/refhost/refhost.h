@@ -145,6 +145,9 @@ class Clip : public OFX::Host::ImageEffect::ClipInstance {
   Effect *effect_;
 };
 
+/// Canonical `r` in pixels at render `scale`, rounded out.
+OfxRectI toPixels(const OfxRectD &r, OfxPointD scale);
+
 /// The value every source clip shows at canonical (x, y): A a smooth ramp,
 /// B a checkerboard, so warps and dissolves change what the output holds.
 float sourceValue(const std::string &clip, double x, double y, int channel);

@@ -99,6 +99,14 @@ impl Frame {
         }
     }
 
+    /// `img` stored as this frame is (depth, row order, alpha state, aspect).
+    fn like(&self, img: &Image) -> Frame {
+        let mut f = Frame::from_image(img, self.depth(), self.top_down);
+        f.premultiplied = self.premultiplied;
+        f.par = self.par;
+        f
+    }
+
     /// One field of an interlaced frame, each of its lines doubled: the
     /// lower field is lines 0, 2, 4, ... (y up), the upper 1, 3, 5, ...
     pub fn field_doubled(&self, upper: bool) -> Frame {
@@ -108,10 +116,7 @@ impl Frame {
             let line = (j - j.rem_euclid(2) + upper as i32).clamp(b.y1, b.y2 - 1);
             src.pixel(i, line)[c]
         });
-        let mut f = Frame::from_image(&img, self.depth(), self.top_down);
-        f.premultiplied = self.premultiplied;
-        f.par = self.par;
-        f
+        self.like(&img)
     }
 
     /// A box-filtered copy at render scale `scale` (proxy renders).
@@ -148,10 +153,7 @@ impl Frame {
                 0.0
             }
         });
-        let mut f = Frame::from_image(&img, self.depth(), self.top_down);
-        f.premultiplied = self.premultiplied;
-        f.par = self.par;
-        f
+        self.like(&img)
     }
 
     /// The image property set handed to the plugin (owning a reference to us).
