@@ -10,12 +10,18 @@ use morphfx::transition::Weights;
 use morphfx::warp::auto::{Correspondence, Grid};
 use morphfx::warp::thin_plate::ThinPlate;
 
+use super::params::table_in_context;
+use super::render::context;
+use super::NodeKind;
 use crate::cache::{Cache, WarpCache};
 use crate::wrapper::clips::Effect;
-use crate::wrapper::{dispatch, Outcome};
+use crate::wrapper::params::Params;
+use crate::wrapper::{dispatch, Failure, Outcome};
 
 #[derive(Default)]
 pub struct Instance {
+    /// The instance's params, their handles fetched once at creation.
+    params: Option<Params>,
     /// A render failure's persistent message is on the node (cleared by the
     /// next good render).
     pub error_shown: AtomicBool,
@@ -50,6 +56,13 @@ pub const PLATES_KEPT: usize = 4;
 pub const PLANES_KEPT: usize = 2;
 
 impl Instance {
+    /// The instance's params.
+    pub fn params(&self) -> Outcome<&Params> {
+        self.params
+            .as_ref()
+            .ok_or_else(|| Failure::Failed("instance created without its params".into()))
+    }
+
     pub fn purge(&self) {
         self.warps.clear();
         *self.scene.lock().unwrap_or_else(|e| e.into_inner()) = None;
@@ -75,8 +88,17 @@ impl Instance {
     }
 }
 
-pub fn create(effect: &Effect) -> Outcome {
-    dispatch::attach_instance(effect, Arc::new(Instance::default()))
+/// Makes the instance's state, with a handle for every param it defines.
+pub fn create(kind: NodeKind, effect: &Effect) -> Outcome {
+    let table = table_in_context(kind, &context(effect));
+    let params = effect
+        .param_set()?
+        .bind(table.iter().map(|p| p.id.as_str()));
+    let instance = Instance {
+        params: Some(params),
+        ..Instance::default()
+    };
+    dispatch::attach_instance(effect, Arc::new(instance))
 }
 
 pub fn destroy(effect: &Effect) -> Outcome {

@@ -16,7 +16,7 @@ use openfx::sys::image_effect_v1::image_effect::*;
 
 use crate::wrapper::clips::Effect;
 use crate::wrapper::props::PropSet;
-use crate::wrapper::{params as host_params, Failure, Outcome};
+use crate::wrapper::{Failure, Outcome, Reply};
 pub use instance::Instance;
 
 pub const PLUGIN_VERSION: (u32, u32) = (1, 0);
@@ -61,16 +61,26 @@ fn is(action: &CStr, name: &CStr) -> bool {
     action == name
 }
 
-/// Runs one action. `Ok(kOfxStatReplyDefault)` for actions we leave to the host.
+/// An action's argument set, or the error that says the host sent none.
+fn arg(args: Option<PropSet>, which: &str, action: &CStr) -> Outcome<PropSet> {
+    args.ok_or_else(|| {
+        Failure::Status(
+            kOfxStatErrBadHandle,
+            format!("{} without {which} arguments", action.to_string_lossy()),
+        )
+    })
+}
+
+/// Runs one action; [`Reply::Default`] for actions we leave to the host.
 pub fn action(
     kind: NodeKind,
     action: &CStr,
     effect: Option<Effect>,
-    in_args: OfxPropertySetHandle,
-    out_args: OfxPropertySetHandle,
-) -> Outcome<OfxStatus> {
+    in_args: Option<PropSet>,
+    out_args: Option<PropSet>,
+) -> Outcome<Reply> {
     if is(action, kOfxActionUnload) {
-        return Ok(kOfxStatOK);
+        return Ok(Reply::Done);
     }
     let effect = effect.ok_or_else(|| {
         Failure::Status(
@@ -78,15 +88,15 @@ pub fn action(
             format!("{} without an effect handle", action.to_string_lossy()),
         )
     })?;
-    let in_props = || PropSet::new(in_args);
-    let out_props = || PropSet::new(out_args);
+    let in_props = || arg(in_args, "in", action);
+    let out_props = || arg(out_args, "out", action);
     if is(action, kOfxActionDescribe) {
         describe(kind, &effect)?;
     } else if is(action, kOfxImageEffectActionDescribeInContext) {
         let context = in_props()?.get_string(kOfxImageEffectPropContext, 0)?;
         describe_in_context(kind, &effect, &context)?;
     } else if is(action, kOfxActionCreateInstance) {
-        instance::create(&effect)?;
+        instance::create(kind, &effect)?;
     } else if is(action, kOfxActionDestroyInstance) {
         instance::destroy(&effect)?;
     } else if is(action, kOfxActionPurgeCaches) {
@@ -107,9 +117,9 @@ pub fn action(
     } else if is(action, kOfxActionInstanceChanged) {
         snap::instance_changed(kind, &effect, &in_props()?)?;
     } else {
-        return Ok(kOfxStatReplyDefault);
+        return Ok(Reply::Default);
     }
-    Ok(kOfxStatOK)
+    Ok(Reply::Done)
 }
 
 fn describe(kind: NodeKind, effect: &Effect) -> Outcome {
@@ -180,17 +190,7 @@ fn describe_in_context(kind: NodeKind, effect: &Effect, context: &str) -> Outcom
         ],
     )?;
     let _ = out.set_int(kOfxImageEffectPropSupportsTiles, 0, 1);
-    let mut table = params::table(kind);
-    if context == render::TRANSITION {
-        // Mandated in this context (Parameters Mandated In A Context): the
-        // plugin defines it, the host drives it.
-        let name = kOfxImageEffectTransitionParamName.to_string_lossy();
-        table.push(spec::ParamSpec::new(
-            name,
-            "",
-            "",
-            spec::Kind::HostDriven { default: 0.0 },
-        ));
-    }
-    host_params::define_all(effect.param_set()?, &table)
+    effect
+        .param_set()?
+        .define_all(&params::table_in_context(kind, context))
 }

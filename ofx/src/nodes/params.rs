@@ -272,6 +272,25 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
     t
 }
 
+/// The params a node defines in `context`: its table, and in the
+/// transition context the mandated `Transition` param (Parameters Mandated
+/// In A Context: the plugin defines it, the host drives it).
+pub fn table_in_context(kind: NodeKind, context: &str) -> Vec<ParamSpec> {
+    let mut table = table(kind);
+    if context == super::render::TRANSITION {
+        table.push(ParamSpec::new(
+            TRANSITION_PARAM,
+            "",
+            "",
+            Kind::HostDriven { default: 0.0 },
+        ));
+    }
+    table
+}
+
+/// The transition context's mandated param (`kOfxImageEffectTransitionParamName`).
+pub const TRANSITION_PARAM: &str = "Transition";
+
 /// Param values at one time. A param the host cannot read keeps its default
 /// (minimal hosts), and is named in `missing` so it can be reported once.
 #[derive(Debug, Clone, PartialEq)]

@@ -21,12 +21,12 @@ use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::message::*;
 
 use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT, PLATES_KEPT};
-use super::params::{Settings, OFFSET_A, OFFSET_B};
+use super::params::{Settings, OFFSET_A, OFFSET_B, TRANSITION_PARAM};
 use super::NodeKind;
 use crate::cache::key_of;
-use crate::wrapper::clips::{Depth, Effect, HostImage, ImageInfo};
+use crate::wrapper::clips::{Depth, Effect, HostImage, HostSample, ImageInfo};
 use crate::wrapper::props::PropSet;
-use crate::wrapper::{Failure, Outcome};
+use crate::wrapper::{Failure, Outcome, Reply};
 
 /// `$body` with `$T` the Rust type of a host bit depth.
 macro_rules! with_depth {
@@ -59,7 +59,10 @@ pub(super) fn context(effect: &Effect) -> String {
 
 /// The frame offsets of the sources (params read without a settings pass).
 fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
-    let Ok(params) = effect.params() else {
+    let Ok(instance) = instance::get(effect) else {
+        return (0.0, 0.0);
+    };
+    let Ok(params) = instance.params() else {
         return (0.0, 0.0);
     };
     let a = params.int(OFFSET_A, time).unwrap_or(0) as f64;
@@ -200,14 +203,14 @@ pub fn is_identity(
     effect: &Effect,
     in_args: &PropSet,
     out_args: &PropSet,
-) -> Outcome<OfxStatus> {
+) -> Outcome<Reply> {
     let time = in_args.get_double(kOfxPropTime, 0)?;
     let instance = instance::get(effect)?;
     let context = context(effect);
-    let settings = Settings::read(&effect.params()?, time, kind);
-    let frame = frame_at(kind, effect, &instance, &settings, time, &context)?;
+    let settings = Settings::read(instance.params()?, time, kind);
+    let frame = frame_at(kind, &instance, &settings, time, &context)?;
     let Some(side) = identity_side(kind, settings.view, &frame) else {
-        return Ok(kOfxStatReplyDefault);
+        return Ok(Reply::Default);
     };
     let (a, b) = kind.source_clips(&context);
     let (name, offset) = match (side, b) {
@@ -215,11 +218,11 @@ pub fn is_identity(
         _ => (a, settings.offset_a),
     };
     if !effect.clip(name)?.is_connected() {
-        return Ok(kOfxStatReplyDefault); // rendered as transparent black
+        return Ok(Reply::Default); // rendered as transparent black
     }
     out_args.set_string(kOfxPropName, 0, name)?;
     out_args.set_double(kOfxPropTime, 0, time + offset as f64)?;
-    Ok(kOfxStatOK)
+    Ok(Reply::Done)
 }
 
 /// Which source the output is at `frame`'s progress, when it is one unchanged.
@@ -286,7 +289,6 @@ struct Frame {
 
 fn frame_at(
     kind: NodeKind,
-    effect: &Effect,
     instance: &Instance,
     settings: &Settings,
     time: f64,
@@ -330,8 +332,10 @@ fn frame_at(
     }
     features.extend(settings.lines.iter().cloned());
     if kind == NodeKind::Morph && context == TRANSITION {
-        let transition = kOfxImageEffectTransitionParamName.to_string_lossy();
-        t = effect.params()?.double(&transition, time)?.clamp(0.0, 1.0);
+        t = instance
+            .params()?
+            .double(TRANSITION_PARAM, time)?
+            .clamp(0.0, 1.0);
     }
     Ok(Frame { features, warp, t })
 }
@@ -339,18 +343,12 @@ fn frame_at(
 /// A source clip's image, or `None` where the host has none: an unconnected
 /// clip, or a fetch that failed, which the spec says to treat as transparent
 /// black and carry on.
-fn source(effect: &Effect, name: &str, time: f64) -> Outcome<Option<(HostImage, ImageInfo)>> {
+fn source(effect: &Effect, name: &str, time: f64) -> Outcome<Option<HostImage>> {
     let clip = effect.clip(name)?;
     if !clip.is_connected() {
         return Ok(None);
     }
-    match clip.image(time)? {
-        Some(image) => {
-            let info = image.info()?;
-            Ok(Some((image, info)))
-        }
-        None => Ok(None),
-    }
+    clip.image(time)
 }
 
 /// The largest frame (canonical px along a side) a warp covers; a larger or
@@ -387,8 +385,8 @@ struct Gathered {
     sequential: bool,
     settings: Settings,
     frame: Frame,
-    a: Option<(HostImage, ImageInfo)>,
-    b: Option<(HostImage, ImageInfo)>,
+    a: Option<HostImage>,
+    b: Option<HostImage>,
     out_info: ImageInfo,
     /// The output's region of definition ([`output_region`]).
     rod: OfxRectD,
@@ -409,7 +407,7 @@ fn gather(
         .unwrap_or(0)
         == 1;
     let context = context(effect);
-    let settings = Settings::read(&effect.params()?, time, kind);
+    let settings = Settings::read(instance.params()?, time, kind);
     if !settings.missing.is_empty() && instance.first_time("missing params") {
         effect.message(
             kOfxMessageWarning,
@@ -420,7 +418,7 @@ fn gather(
             ),
         );
     }
-    let frame = frame_at(kind, effect, instance, &settings, time, &context)?;
+    let frame = frame_at(kind, instance, &settings, time, &context)?;
     let (a_name, b_name) = kind.source_clips(&context);
     let a = source(effect, a_name, time + settings.offset_a as f64)?;
     let b = match b_name {
@@ -431,7 +429,7 @@ fn gather(
         .clip("Output")?
         .image(time)?
         .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
-    let out_info = out.info()?;
+    let out_info = *out.info();
     let rod = output_region(kind, effect, &context, time)?;
     let project = project(effect, &rod);
     let gathered = Gathered {
@@ -450,12 +448,12 @@ fn gather(
 }
 
 /// A view over `source`'s pixels, or over one transparent black pixel.
-fn view_of<'a, S: Sample>(
-    source: &'a Option<(HostImage, ImageInfo)>,
+fn view_of<'a, S: HostSample>(
+    source: &'a Option<HostImage>,
     black: &'a [S; 4],
 ) -> Outcome<ImageView<'a, S>> {
     match source {
-        Some((image, info)) => image.view::<S>(info),
+        Some(image) => image.view::<S>(),
         None => {
             ImageView::new(black, Layout::packed(RectI::new(0, 0, 1, 1), 4)).map_err(Failure::from)
         }
@@ -470,37 +468,42 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         g.out_info.render_scale.1,
         g.out_info.par,
     );
-    let scale_of = |s: &Option<(HostImage, ImageInfo)>| match s {
-        Some((_, i)) => PixelScale::new(i.render_scale.0, i.render_scale.1, i.par),
+    let scale_of = |s: &Option<HostImage>| match s {
+        Some(image) => {
+            let i = image.info();
+            PixelScale::new(i.render_scale.0, i.render_scale.1, i.par)
+        }
         None => out_scale,
     };
     let (a_scale, b_scale) = (scale_of(&g.a), scale_of(&g.b));
     // Both sources are read at one depth (the descriptor says so); a missing
     // one takes the other's, or the output's.
-    let depth = match (&g.a, &g.b) {
-        (Some((_, a)), Some((_, b))) if a.depth != b.depth => {
+    let depth = match (
+        g.a.as_ref().map(HostImage::info),
+        g.b.as_ref().map(HostImage::info),
+    ) {
+        (Some(a), Some(b)) if a.depth != b.depth => {
             return Err(Failure::BadInput(
                 "Source A and Source B have different bit depths".into(),
             ))
         }
-        (Some((_, i)), _) | (None, Some((_, i))) => i.depth,
+        (Some(i), _) | (None, Some(i)) => i.depth,
         (None, None) => g.out_info.depth,
     };
-    let premultiplied =
-        |s: &Option<(HostImage, ImageInfo)>| s.as_ref().is_none_or(|(_, i)| i.premultiplied);
+    let premultiplied = |s: &Option<HostImage>| s.as_ref().is_none_or(|i| i.info().premultiplied);
     if g.frame.warp.method == Method::Auto {
-        let (Some((a_img, a_info)), Some((b_img, b_info))) = (&g.a, &g.b) else {
+        let (Some(a_img), Some(b_img)) = (&g.a, &g.b) else {
             return Err(Failure::BadInput(
                 "method \"auto\" finds its warp from two images: connect both sources (Morph node)"
                     .into(),
             ));
         };
         let (a_work, b_work) = with_depth!(depth, S => (
-            WorkImage::from_view(&a_img.view::<S>(a_info)?),
-            WorkImage::from_view(&b_img.view::<S>(b_info)?),
+            WorkImage::from_view(&a_img.view::<S>()?),
+            WorkImage::from_view(&b_img.view::<S>()?),
         ));
-        let a_frame = canonical(a_info.bounds, a_scale);
-        let b_frame = canonical(b_info.bounds, b_scale);
+        let a_frame = canonical(a_img.info().bounds, a_scale);
+        let b_frame = canonical(b_img.info().bounds, b_scale);
         g.frame.warp.correspondence = Some(correspondence(
             &instance,
             &g.frame,
@@ -518,11 +521,11 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
     let (a, b) = (&g.a, &g.b);
     let settings = &g.settings;
     with_depth!(g.out_info.depth, D => {
-        let rows = out.rows_mut::<D>(&g.out_info, g.window)?;
+        let rows = out.rows_mut::<D>(g.window)?;
         with_depth!(depth, S => {
             // Transparent black: the stand-in for a source with no image.
             let black = [S::default(); 4];
-            let edge = |s: &Option<(HostImage, ImageInfo)>| if s.is_some() { settings.edge } else { EdgeMode::Black };
+            let edge = |s: &Option<HostImage>| if s.is_some() { settings.edge } else { EdgeMode::Black };
             let a_sampler = Sampler::new(view_of::<S>(a, &black)?, a_scale, settings.filter, edge(a), premultiplied(a));
             if kind == NodeKind::Morph {
                 let b_sampler = Sampler::new(view_of::<S>(b, &black)?, b_scale, settings.filter, edge(b), premultiplied(b));
@@ -635,7 +638,7 @@ fn prepare<'g>(
 /// output is premultiplied unless every source with an image is straight
 /// (see [`clip_preferences`]), and a dissolve adds like to like.
 fn premultiply(g: &Gathered) -> [bool; 2] {
-    let straight = |s: &Option<(HostImage, ImageInfo)>| s.as_ref().map(|(_, i)| !i.premultiplied);
+    let straight = |s: &Option<HostImage>| s.as_ref().map(|i| !i.info().premultiplied);
     let (a, b) = (straight(&g.a), straight(&g.b));
     let output_straight = a.unwrap_or(true) && b.unwrap_or(true) && (a.is_some() || b.is_some());
     [

@@ -22,8 +22,9 @@ pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> O
         return Ok(());
     }
     let time = in_args.get_double(kOfxPropTime, 0)?;
-    let params = effect.params()?;
-    let settings = Settings::read(&params, time, kind);
+    let instance = instance::get(effect)?;
+    let params = instance.params()?;
+    let settings = Settings::read(params, time, kind);
     let sigma = params
         .double(SNAP_SIGMA, time)
         .unwrap_or(3.0)
@@ -63,7 +64,7 @@ pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> O
         keys.iter()
             .try_for_each(|(id, p)| params.set_point_at(id, time, (p.x, p.y)))
     })?;
-    instance::get(effect)?.purge();
+    instance.purge();
     Ok(())
 }
 
@@ -102,13 +103,13 @@ fn edge_energy(
             "Snap Lines: clip {name} has no image at frame {time}"
         ))
     })?;
-    let info = image.info()?;
+    let info = image.info();
     let scale = PixelScale::new(info.render_scale.0, info.render_scale.1, info.par);
     let sigma = sigma * scale.y;
     let energy = match info.depth {
-        Depth::U8 => EdgeEnergy::new(image.view::<u8>(&info)?, sigma),
-        Depth::U16 => EdgeEnergy::new(image.view::<u16>(&info)?, sigma),
-        Depth::F32 => EdgeEnergy::new(image.view::<f32>(&info)?, sigma),
+        Depth::U8 => EdgeEnergy::new(image.view::<u8>()?, sigma),
+        Depth::U16 => EdgeEnergy::new(image.view::<u16>()?, sigma),
+        Depth::F32 => EdgeEnergy::new(image.view::<f32>()?, sigma),
     };
     Ok((energy, scale))
 }

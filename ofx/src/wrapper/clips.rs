@@ -10,7 +10,7 @@ use openfx::sys::image_effect_v1::message::*;
 use openfx::sys::image_effect_v1::param::*;
 
 use super::host::{self, Suites};
-use super::params::Params;
+use super::params::ParamSet;
 use super::props::PropSet;
 use super::{check, Failure, Outcome};
 
@@ -21,7 +21,14 @@ pub struct Effect {
 }
 
 impl Effect {
-    pub fn new(handle: *const c_void) -> Outcome<Self> {
+    /// The effect behind a host's handle.
+    ///
+    /// # Safety
+    /// `handle` is null (refused) or an image effect handle (descriptor or
+    /// instance) the host passed to the current action, valid for as long as
+    /// the returned value is used: the host keeps instance handles alive
+    /// until destroyInstance and descriptors until unload.
+    pub unsafe fn from_raw(handle: *const c_void) -> Outcome<Self> {
         if handle.is_null() {
             return Err(Failure::Status(
                 kOfxStatErrBadHandle,
@@ -43,10 +50,11 @@ impl Effect {
         let mut p: OfxPropertySetHandle = std::ptr::null_mut();
         // SAFETY: handle is the host's effect handle for this action; out-pointer live.
         check(unsafe { f(self.handle, &mut p) }, "getPropertySet")?;
-        PropSet::new(p)
+        // SAFETY: the host just returned it for this effect, which owns it.
+        unsafe { PropSet::from_raw(p) }
     }
 
-    pub fn param_set(&self) -> Outcome<OfxParamSetHandle> {
+    pub fn param_set(&self) -> Outcome<ParamSet> {
         let f = self
             .suites
             .effect
@@ -55,11 +63,8 @@ impl Effect {
         let mut p: OfxParamSetHandle = std::ptr::null_mut();
         // SAFETY: as above.
         check(unsafe { f(self.handle, &mut p) }, "getParamSet")?;
-        Ok(p)
-    }
-
-    pub fn params(&self) -> Outcome<Params> {
-        Params::new(self.param_set()?)
+        // SAFETY: the host just returned it for this effect, which owns it.
+        unsafe { ParamSet::from_raw(p) }
     }
 
     pub fn define_clip(&self, name: &str) -> Outcome<PropSet> {
@@ -75,7 +80,8 @@ impl Effect {
             unsafe { f(self.handle, n.as_ptr(), &mut p) },
             &format!("defining clip {name}"),
         )?;
-        PropSet::new(p)
+        // SAFETY: the host just returned the clip descriptor's properties.
+        unsafe { PropSet::from_raw(p) }
     }
 
     pub fn clip(&self, name: &str) -> Outcome<Clip> {
@@ -189,7 +195,8 @@ impl Clip {
         let mut p: OfxPropertySetHandle = std::ptr::null_mut();
         // SAFETY: clip handle from clipGetHandle; out-pointer live.
         check(unsafe { f(self.handle, &mut p) }, "clipGetPropertySet")?;
-        PropSet::new(p)
+        // SAFETY: the host just returned the clip's properties.
+        unsafe { PropSet::from_raw(p) }
     }
 
     pub fn is_connected(&self) -> bool {
@@ -235,15 +242,21 @@ impl Clip {
             return Ok(None);
         }
         check(status, &format!("image of clip {} at {time}", self.name))?;
-        let img = HostImage {
-            props: PropSet::new(p)?,
-            suites: self.suites,
+        // SAFETY: the host just lent us this image; it stays valid until
+        // clipReleaseImage, which only HostImage's Drop calls.
+        let props = unsafe { PropSet::from_raw(p)? };
+        let mut image = HostImage {
+            release: Some((props, self.suites)),
+            info: ImageInfo::default(),
             clip: self.name.clone(),
         };
-        Ok(Some(img))
+        // Read after the image owns the handle, so a bad property still releases it.
+        image.info = image_info(&props, &self.name)?;
+        Ok(Some(image))
     }
 }
 
+/// A host bit depth.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Depth {
     U8,
@@ -251,10 +264,36 @@ pub enum Depth {
     F32,
 }
 
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for u8 {}
+    impl Sealed for u16 {}
+    impl Sealed for f32 {}
+}
+
+/// A sample type a host image can hold, with the bit depth that says so.
+/// Sealed: only `u8`, `u16` and `f32` are OFX depths, and [`HostImage`]'s
+/// views are sound only for a type whose depth the image's matches.
+pub trait HostSample: Sample + sealed::Sealed {
+    const DEPTH: Depth;
+}
+impl HostSample for u8 {
+    const DEPTH: Depth = Depth::U8;
+}
+impl HostSample for u16 {
+    const DEPTH: Depth = Depth::U16;
+}
+impl HostSample for f32 {
+    const DEPTH: Depth = Depth::F32;
+}
+
 /// An image the host lent us; released when dropped.
 pub struct HostImage {
-    props: PropSet,
-    suites: Suites,
+    /// The image's property set and the suites to release it with (`None`
+    /// for an image over memory of our own, in tests).
+    release: Option<(PropSet, Suites)>,
+    /// What the properties said about the memory, read once when lent.
+    info: ImageInfo,
     clip: String,
 }
 
@@ -271,71 +310,118 @@ pub struct ImageInfo {
     pub render_scale: (f64, f64),
 }
 
+impl Default for ImageInfo {
+    fn default() -> Self {
+        ImageInfo {
+            data: std::ptr::null_mut(),
+            bounds: RectI::default(),
+            row_bytes: 0,
+            depth: Depth::F32,
+            channels: 4,
+            premultiplied: true,
+            par: 1.0,
+            render_scale: (1.0, 1.0),
+        }
+    }
+}
+
+/// Reads an image's properties.
+fn image_info(p: &PropSet, clip: &str) -> Outcome<ImageInfo> {
+    let bad = |what: String| Failure::BadInput(format!("clip {clip}: {what}"));
+    let depth = match p.get_string(kOfxImageEffectPropPixelDepth, 0)?.as_bytes() {
+        b"OfxBitDepthByte" => Depth::U8,
+        b"OfxBitDepthShort" => Depth::U16,
+        b"OfxBitDepthFloat" => Depth::F32,
+        other => {
+            return Err(bad(format!(
+                "unsupported bit depth {}",
+                String::from_utf8_lossy(other)
+            )))
+        }
+    };
+    let channels = match p.get_string(kOfxImageEffectPropComponents, 0)?.as_str() {
+        "OfxImageComponentRGBA" => 4,
+        "OfxImageComponentRGB" => 3,
+        "OfxImageComponentAlpha" => 1,
+        other => return Err(bad(format!("unsupported components {other}"))),
+    };
+    let [x1, y1, x2, y2] = p.get_ints::<4>(kOfxImagePropBounds)?;
+    let premult = p
+        .get_string(kOfxImageEffectPropPreMultiplication, 0)
+        .unwrap_or_default();
+    let scale = |k| {
+        p.get_double(kOfxImageEffectPropRenderScale, k)
+            .unwrap_or(1.0)
+    };
+    Ok(ImageInfo {
+        data: p.get_pointer(kOfxImagePropData, 0)?,
+        bounds: RectI::new(x1, y1, x2, y2),
+        row_bytes: p.get_int(kOfxImagePropRowBytes, 0)? as isize,
+        depth,
+        channels,
+        premultiplied: premult != "OfxImageUnPreMultiplied",
+        par: p
+            .get_double(kOfxImagePropPixelAspectRatio, 0)
+            .unwrap_or(1.0),
+        render_scale: (scale(0), scale(1)),
+    })
+}
+
 impl HostImage {
-    pub fn info(&self) -> Outcome<ImageInfo> {
-        let p = &self.props;
-        let bad = |what: String| Failure::BadInput(format!("clip {}: {what}", self.clip));
-        let depth = match p.get_string(kOfxImageEffectPropPixelDepth, 0)?.as_bytes() {
-            b"OfxBitDepthByte" => Depth::U8,
-            b"OfxBitDepthShort" => Depth::U16,
-            b"OfxBitDepthFloat" => Depth::F32,
-            other => {
-                return Err(bad(format!(
-                    "unsupported bit depth {}",
-                    String::from_utf8_lossy(other)
-                )))
-            }
-        };
-        let channels = match p.get_string(kOfxImageEffectPropComponents, 0)?.as_str() {
-            "OfxImageComponentRGBA" => 4,
-            "OfxImageComponentRGB" => 3,
-            "OfxImageComponentAlpha" => 1,
-            other => return Err(bad(format!("unsupported components {other}"))),
-        };
-        let [x1, y1, x2, y2] = p.get_ints::<4>(kOfxImagePropBounds)?;
-        let premult = p
-            .get_string(kOfxImageEffectPropPreMultiplication, 0)
-            .unwrap_or_default();
-        Ok(ImageInfo {
-            data: p.get_pointer(kOfxImagePropData, 0)?,
-            bounds: RectI::new(x1, y1, x2, y2),
-            row_bytes: p.get_int(kOfxImagePropRowBytes, 0)? as isize,
-            depth,
-            channels,
-            premultiplied: premult != "OfxImageUnPreMultiplied",
-            par: p
-                .get_double(kOfxImagePropPixelAspectRatio, 0)
-                .unwrap_or(1.0),
-            render_scale: (
-                p.get_double(kOfxImageEffectPropRenderScale, 0)
-                    .unwrap_or(1.0),
-                p.get_double(kOfxImageEffectPropRenderScale, 1)
-                    .unwrap_or(1.0),
-            ),
-        })
+    /// An image over memory the caller owns, released by nobody: how tests
+    /// exercise the layout checks without a host.
+    ///
+    /// # Safety
+    /// `info.data` addresses `info.bounds` rows of `info.row_bytes` bytes
+    /// holding samples of `info.depth`, as a host's image would, valid for
+    /// as long as the returned image lives.
+    #[cfg(test)]
+    pub(crate) unsafe fn over(info: ImageInfo) -> HostImage {
+        HostImage {
+            release: None,
+            info,
+            clip: "test".into(),
+        }
     }
 
-    fn checked_layout<T: Sample>(&self, info: &ImageInfo) -> Outcome<()> {
+    /// What the host said about the image.
+    pub fn info(&self) -> &ImageInfo {
+        &self.info
+    }
+
+    /// Refuses a layout that views of `T` could not cover soundly.
+    fn checked_layout<T: HostSample>(&self) -> Outcome<()> {
+        let info = &self.info;
         let size = std::mem::size_of::<T>();
-        let bad = |what: &str| Failure::BadInput(format!("clip {}: {what}", self.clip));
+        let bad = |what: String| Failure::BadInput(format!("clip {}: {what}", self.clip));
+        if T::DEPTH != info.depth {
+            return Err(Failure::Failed(format!(
+                "clip {}: a {:?} image read as {:?} samples",
+                self.clip,
+                info.depth,
+                T::DEPTH
+            )));
+        }
         if info.data.is_null() && !info.bounds.is_empty() {
-            return Err(bad("image has no pixel data"));
+            return Err(bad("image has no pixel data".into()));
         }
         if info.row_bytes % size as isize != 0
             || !(info.data as usize).is_multiple_of(std::mem::align_of::<T>())
         {
-            return Err(bad("image rows are not aligned to its pixel type"));
+            return Err(bad("image rows are not aligned to its pixel type".into()));
         }
         let row_len = info.bounds.width() * info.channels * size;
         if info.bounds.height() > 1 && (info.row_bytes.unsigned_abs()) < row_len {
-            return Err(bad("image row bytes are smaller than a row"));
+            return Err(bad("image row bytes are smaller than a row".into()));
         }
         Ok(())
     }
 
-    /// A read-only view over the whole image.
-    pub fn view<T: Sample>(&self, info: &ImageInfo) -> Outcome<ImageView<'_, T>> {
-        self.checked_layout::<T>(info)?;
+    /// A read-only view over the whole image; an error unless `T` is the
+    /// image's own sample type.
+    pub fn view<T: HostSample>(&self) -> Outcome<ImageView<'_, T>> {
+        self.checked_layout::<T>()?;
+        let info = &self.info;
         let size = std::mem::size_of::<T>() as isize;
         let (h, row_elems) = (
             info.bounds.height() as isize,
@@ -350,9 +436,11 @@ impl HostImage {
         let (lo, hi) = (last_row.min(0), last_row.max(0) + row_elems);
         // SAFETY: the host guarantees `data` addresses pixel (x1, y1) and that
         // every row y1..y2 at `data + k * rowBytes` holds `width * channels`
-        // samples of type T (checked: depth matches T, alignment, row size),
-        // valid for reading until clipReleaseImage, which only our Drop calls;
-        // the slice borrows `self`, so it cannot outlive the image.
+        // samples of the image's depth, valid for reading until
+        // clipReleaseImage, which only our Drop calls. `checked_layout` made
+        // sure T is that depth's type, the pointer and stride are aligned to
+        // T, and rows do not overlap; the slice borrows `self`, so it cannot
+        // outlive the image.
         let data = unsafe {
             std::slice::from_raw_parts((info.data as *const T).offset(lo), (hi - lo) as usize)
         };
@@ -365,13 +453,11 @@ impl HostImage {
         ImageView::new(data, layout).map_err(Failure::from)
     }
 
-    /// The rows of `window` (clipped to the bounds) for writing.
-    pub fn rows_mut<T: Sample>(
-        &mut self,
-        info: &ImageInfo,
-        window: RectI,
-    ) -> Outcome<RowsMut<'_, T>> {
-        self.checked_layout::<T>(info)?;
+    /// The rows of `window` (clipped to the bounds) for writing; an error
+    /// unless `T` is the image's own sample type.
+    pub fn rows_mut<T: HostSample>(&mut self, window: RectI) -> Outcome<RowsMut<'_, T>> {
+        self.checked_layout::<T>()?;
+        let info = &self.info;
         let w = window.intersect(&info.bounds);
         let size = std::mem::size_of::<T>() as isize;
         let stride = info.row_bytes / size;
@@ -380,11 +466,12 @@ impl HostImage {
             let offset = (j - info.bounds.y1) as isize * stride
                 + (w.x1 - info.bounds.x1) as isize * info.channels as isize;
             // SAFETY: as in `view`, the host's buffer holds every row of the
-            // bounds; this row segment covers only the render window's columns
-            // of one row, so segments are disjoint from each other and from
-            // the windows that other render threads write (OFX render windows
-            // of concurrent calls do not overlap). `&mut self` keeps this
-            // image's rows from being handed out twice.
+            // bounds in samples of type T (checked); this row segment covers
+            // only the render window's columns of one row, so segments are
+            // disjoint from each other and from the windows that other render
+            // threads write (OFX render windows of concurrent calls do not
+            // overlap). `&mut self` keeps this image's rows from being handed
+            // out twice.
             let row = unsafe {
                 std::slice::from_raw_parts_mut(
                     (info.data as *mut T).offset(offset),
@@ -403,11 +490,87 @@ impl HostImage {
 
 impl Drop for HostImage {
     fn drop(&mut self) {
-        if let Some(f) = self.suites.effect.clipReleaseImage {
+        let Some((props, suites)) = &self.release else {
+            return;
+        };
+        if let Some(f) = suites.effect.clipReleaseImage {
             // SAFETY: the property set is the image handle clipGetImage gave us, released once.
             unsafe {
-                f(self.props.handle());
+                f(props.handle());
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3x2 RGBA image of `T` over `buf`.
+    fn image_over<T: HostSample>(buf: &mut [T], depth: Depth) -> HostImage {
+        let info = ImageInfo {
+            data: buf.as_mut_ptr() as *mut c_void,
+            bounds: RectI::new(0, 0, 3, 2),
+            row_bytes: (3 * 4 * std::mem::size_of::<T>()) as isize,
+            depth,
+            ..ImageInfo::default()
+        };
+        assert!(buf.len() >= 24);
+        // SAFETY: `buf` holds the 2 rows of 3 RGBA samples `info` describes
+        // and outlives the image (both die at the end of the caller's test).
+        unsafe { HostImage::over(info) }
+    }
+
+    fn views<T: HostSample>(image: &mut HostImage) -> [bool; 2] {
+        [
+            image.view::<T>().is_ok(),
+            image.rows_mut::<T>(RectI::new(0, 0, 3, 2)).is_ok(),
+        ]
+    }
+
+    /// Every (image depth, sample type) pair: only the matching type views
+    /// the image, read or write; the rest are refused, never sliced.
+    #[test]
+    fn only_the_images_own_sample_type_views_it() {
+        let mut bytes = vec![0u8; 24];
+        let mut shorts = vec![0u16; 24];
+        let mut floats = vec![0f32; 24];
+        let mut images = [
+            image_over(&mut bytes, Depth::U8),
+            image_over(&mut shorts, Depth::U16),
+            image_over(&mut floats, Depth::F32),
+        ];
+        for image in images.iter_mut() {
+            let depth = image.info().depth;
+            assert_eq!(
+                views::<u8>(image),
+                [depth == Depth::U8; 2],
+                "{depth:?} as u8"
+            );
+            assert_eq!(
+                views::<u16>(image),
+                [depth == Depth::U16; 2],
+                "{depth:?} as u16"
+            );
+            assert_eq!(
+                views::<f32>(image),
+                [depth == Depth::F32; 2],
+                "{depth:?} as f32"
+            );
+        }
+        // The one the issue found: an 8-bit image read as floats would have
+        // been a slice four times its buffer.
+        let Err(err) = images[0].view::<f32>() else {
+            panic!("an 8-bit image viewed as floats");
+        };
+        assert!(err.message().contains("U8 image read as F32"), "{err:?}");
+    }
+
+    #[test]
+    fn a_matching_view_reads_the_hosts_samples() {
+        let mut floats: Vec<f32> = (0..24).map(|v| v as f32).collect();
+        let image = image_over(&mut floats, Depth::F32);
+        let view = image.view::<f32>().expect("view");
+        assert_eq!(view.pixel(2, 1), &[20.0, 21.0, 22.0, 23.0][..]);
     }
 }

@@ -9,10 +9,19 @@ use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 
 use super::clips::Effect;
-use super::{Failure, Outcome, BAD_INPUT_ID};
+use super::props::PropSet;
+use super::{Failure, Outcome, Reply, BAD_INPUT_ID};
 use crate::nodes::{self, Instance, NodeKind};
 
-pub fn dispatch(
+/// Runs `action` of a `kind` node and answers its status.
+///
+/// # Safety
+/// The arguments are an OFX main entry's, as the host passed them: `action`
+/// null or a NUL-terminated string; `handle` null or the effect handle of
+/// the action; `in_args` and `out_args` null or the action's property sets;
+/// all valid until this call returns (instance handles longer: until
+/// destroyInstance), which the OFX API promises of every host.
+pub unsafe fn dispatch(
     kind: NodeKind,
     action: *const c_char,
     handle: *const c_void,
@@ -24,6 +33,10 @@ pub fn dispatch(
     }
     // SAFETY: the host passes a NUL-terminated action name (checked non-null).
     let action = unsafe { CStr::from_ptr(action) };
+    // SAFETY (all three): handles of this action, per this function's contract.
+    let effect = (!handle.is_null()).then(|| unsafe { Effect::from_raw(handle) });
+    let args = |p: OfxPropertySetHandle| (!p.is_null()).then(|| unsafe { PropSet::from_raw(p) });
+    let (in_args, out_args) = (args(in_args), args(out_args));
     let result = catch_unwind(AssertUnwindSafe(|| {
         let forced = &super::host::switches().force_panic;
         if forced
@@ -37,19 +50,19 @@ pub fn dispatch(
         }
         // Suites may be fetched from the load action on (not in setHost).
         if action == kOfxActionLoad {
-            return super::host::load().map(|()| kOfxStatOK);
+            return super::host::load().map(|()| Reply::Done);
         }
-        let effect = if handle.is_null() {
-            None
-        } else {
-            Some(Effect::new(handle)?)
-        };
+        let effect = effect.clone().transpose()?;
+        let in_args = in_args.clone().transpose()?;
+        let out_args = out_args.clone().transpose()?;
         nodes::action(kind, action, effect, in_args, out_args)
     }));
+    let effect = effect.and_then(Result::ok);
     match result {
-        Ok(Ok(status)) => status,
+        Ok(Ok(Reply::Done)) => kOfxStatOK,
+        Ok(Ok(Reply::Default)) => kOfxStatReplyDefault,
         Ok(Err(failure)) => {
-            report(handle, action, &failure);
+            report(effect.as_ref(), action, &failure);
             failure.status()
         }
         Err(panic) => {
@@ -63,7 +76,9 @@ pub fn dispatch(
                 action.to_string_lossy()
             ));
             // Reporting must not unwind either.
-            let _ = catch_unwind(AssertUnwindSafe(|| report(handle, action, &failure)));
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                report(effect.as_ref(), action, &failure)
+            }));
             kOfxStatFailed
         }
     }
@@ -82,15 +97,15 @@ const RENDER_TIME: [&CStr; 7] = [
     kOfxImageEffectActionEndSequenceRender,
 ];
 
-fn report(handle: *const c_void, action: &CStr, failure: &Failure) {
+fn report(effect: Option<&Effect>, action: &CStr, failure: &Failure) {
     let id = match failure {
         Failure::BadInput(_) => BAD_INPUT_ID,
         _ => c"net.morphfx.Error",
     };
     let text = failure.message();
-    let effect = match Effect::new(handle) {
-        Ok(effect) if !handle.is_null() => effect,
-        _ => {
+    let effect = match effect {
+        Some(effect) => effect,
+        None => {
             use std::io::Write;
             let _ = writeln!(
                 std::io::stderr(),
@@ -101,7 +116,7 @@ fn report(handle: *const c_void, action: &CStr, failure: &Failure) {
         }
     };
     if RENDER_TIME.contains(&action) {
-        if let Ok(instance) = instance(&effect) {
+        if let Ok(instance) = instance(effect) {
             if effect.persistent_error(id, text) {
                 instance
                     .error_shown

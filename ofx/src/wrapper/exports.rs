@@ -33,7 +33,9 @@ macro_rules! entry {
             in_args: OfxPropertySetHandle,
             out_args: OfxPropertySetHandle,
         ) -> OfxStatus {
-            dispatch($kind, action, handle, in_args, out_args)
+            // SAFETY: the host calls this entry point with an action's
+            // arguments, which is `dispatch`'s contract.
+            unsafe { dispatch($kind, action, handle, in_args, out_args) }
         }
     };
 }

@@ -32,6 +32,16 @@ pub const BAD_INPUT_ID: &CStr = c"net.morphfx.BadInput";
 
 pub type Outcome<T = ()> = Result<T, Failure>;
 
+/// How an action that did not fail ended: the nodes answer this, never an
+/// `OfxStatus` (the wrapper alone speaks statuses).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reply {
+    /// Done (`kOfxStatOK`).
+    Done,
+    /// Left to the host's default behaviour (`kOfxStatReplyDefault`).
+    Default,
+}
+
 impl From<morphfx::Error> for Failure {
     fn from(e: morphfx::Error) -> Self {
         match e {

@@ -1,5 +1,6 @@
 //! Defining params from [`ParamSpec`] tables and reading their values.
 
+use std::collections::HashMap;
 use std::ffi::{c_char, c_int, CStr, CString};
 
 use openfx::sys::generic::core::*;
@@ -17,16 +18,81 @@ fn cstr(s: &str) -> CString {
 /// the warps cover, either side of the origin.
 pub const POINT_RANGE: (f64, f64) = (-131072.0, 131072.0);
 
-/// Defines every param of `specs` on `param_set` (describe-in-context).
-pub fn define_all(param_set: OfxParamSetHandle, specs: &[ParamSpec]) -> Outcome {
-    for spec in specs {
-        define(param_set, spec)?;
-    }
-    Ok(())
+/// An effect's param set: where params are defined (on a descriptor) and
+/// their handles fetched (on an instance).
+#[derive(Clone, Copy)]
+pub struct ParamSet {
+    set: OfxParamSetHandle,
+    suite: &'static OfxParameterSuiteV1,
 }
 
-fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
-    let suite = host::suites()?.param;
+impl ParamSet {
+    /// The param set behind a host's handle.
+    ///
+    /// # Safety
+    /// `set` is null (refused) or the param set handle the host's
+    /// getParamSet returned for an effect that is still alive while the
+    /// value (and any [`Params`] bound from it) is used.
+    pub unsafe fn from_raw(set: OfxParamSetHandle) -> Outcome<Self> {
+        if set.is_null() {
+            return Err(Failure::Status(
+                kOfxStatErrBadHandle,
+                "null param set".into(),
+            ));
+        }
+        Ok(ParamSet {
+            set,
+            suite: host::suites()?.param,
+        })
+    }
+
+    /// Defines every param of `specs` (describe-in-context).
+    pub fn define_all(&self, specs: &[ParamSpec]) -> Outcome {
+        for spec in specs {
+            self.define(spec)?;
+        }
+        Ok(())
+    }
+
+    /// The handles of the params named `ids`, fetched once (an instance
+    /// keeps them for its life). A param the host cannot hand over is left
+    /// out: reading it fails, and the reader falls back to its default.
+    pub fn bind<'a>(&self, ids: impl IntoIterator<Item = &'a str>) -> Params {
+        let handles = ids
+            .into_iter()
+            .filter_map(|id| Some((id.to_owned(), self.handle(id).ok()?)))
+            .collect();
+        Params {
+            set: *self,
+            handles,
+        }
+    }
+
+    fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
+        let get = self
+            .suite
+            .paramGetHandle
+            .ok_or_else(|| Failure::Failed("host has no paramGetHandle".into()))?;
+        let name = cstr(id);
+        let mut h: OfxParamHandle = std::ptr::null_mut();
+        // SAFETY: set is the instance's param set; name NUL-terminated; out-pointer live.
+        let status = unsafe { get(self.set, name.as_ptr(), &mut h, std::ptr::null_mut()) };
+        check(status, &format!("param {id}"))?;
+        if h.is_null() {
+            return Err(Failure::Status(
+                kOfxStatErrBadHandle,
+                format!("param {id}: null handle"),
+            ));
+        }
+        Ok(h)
+    }
+
+    fn define(&self, spec: &ParamSpec) -> Outcome {
+        define(self.set, self.suite, spec)
+    }
+}
+
+fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &ParamSpec) -> Outcome {
     let define = suite
         .paramDefine
         .ok_or_else(|| Failure::Failed("host has no paramDefine".into()))?;
@@ -47,7 +113,8 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
     // type and name are NUL-terminated; `props` is a live out-pointer.
     let status = unsafe { define(param_set, kind.as_ptr(), name.as_ptr(), &mut props) };
     check(status, &format!("defining param {}", spec.id))?;
-    let p = PropSet::new(props)?;
+    // SAFETY: the host just returned the new param's properties.
+    let p = unsafe { PropSet::from_raw(props)? };
     if let Kind::HostDriven { default } = spec.kind {
         p.set_double(kOfxParamPropDefault, 0, default)?;
         let _ = p.set_double(kOfxParamPropMin, 0, 0.0);
@@ -144,44 +211,27 @@ fn define(param_set: OfxParamSetHandle, spec: &ParamSpec) -> Outcome {
     Ok(())
 }
 
-/// Reads param values of one instance.
-#[derive(Clone, Copy)]
+/// One instance's params, their handles fetched once.
 pub struct Params {
-    set: OfxParamSetHandle,
-    suite: &'static OfxParameterSuiteV1,
+    set: ParamSet,
+    handles: HashMap<String, OfxParamHandle>,
 }
 
-impl Params {
-    pub fn new(set: OfxParamSetHandle) -> Outcome<Self> {
-        if set.is_null() {
-            return Err(Failure::Status(
-                kOfxStatErrBadHandle,
-                "null param set".into(),
-            ));
-        }
-        Ok(Params {
-            set,
-            suite: host::suites()?.param,
-        })
-    }
+// SAFETY: param handles are the host's, valid for the instance's life
+// (`ParamSet::from_raw`'s contract); OFX lets render threads read param
+// values through them concurrently, and writes (instanceChanged only) are
+// the host's to serialise. The map itself is never changed after `bind`.
+unsafe impl Send for Params {}
+unsafe impl Sync for Params {}
 
+impl Params {
     fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
-        let get = self
-            .suite
-            .paramGetHandle
-            .ok_or_else(|| Failure::Failed("host has no paramGetHandle".into()))?;
-        let name = cstr(id);
-        let mut h: OfxParamHandle = std::ptr::null_mut();
-        // SAFETY: set is the instance's param set; name NUL-terminated; out-pointer live.
-        let status = unsafe { get(self.set, name.as_ptr(), &mut h, std::ptr::null_mut()) };
-        check(status, &format!("param {id}"))?;
-        if h.is_null() {
-            return Err(Failure::Status(
-                kOfxStatErrBadHandle,
-                format!("param {id}: null handle"),
-            ));
-        }
-        Ok(h)
+        self.handles.get(id).copied().ok_or_else(|| {
+            Failure::Status(
+                kOfxStatErrUnknown,
+                format!("param {id}: the host has no such param"),
+            )
+        })
     }
 
     fn get_at(
@@ -192,6 +242,7 @@ impl Params {
         unsafe extern "C" fn(OfxParamHandle, OfxTime, ...) -> OfxStatus,
     )> {
         let f = self
+            .set
             .suite
             .paramGetValueAtTime
             .ok_or_else(|| Failure::Failed("host has no paramGetValueAtTime".into()))?;
@@ -235,6 +286,7 @@ impl Params {
     /// Keys a Double2D param at `time` (the host adds or moves the key).
     pub fn set_point_at(&self, id: &str, time: f64, (x, y): (f64, f64)) -> Outcome {
         let f = self
+            .set
             .suite
             .paramSetValueAtTime
             .ok_or_else(|| Failure::Failed("host has no paramSetValueAtTime".into()))?;
@@ -247,16 +299,19 @@ impl Params {
     /// the host makes it one undo step. The block is closed whatever
     /// `writes` returns.
     pub fn edit_block<R>(&self, name: &str, writes: impl FnOnce() -> Outcome<R>) -> Outcome<R> {
-        let (begin, end) = match (self.suite.paramEditBegin, self.suite.paramEditEnd) {
+        let (begin, end) = match (self.set.suite.paramEditBegin, self.set.suite.paramEditEnd) {
             (Some(b), Some(e)) => (b, e),
             _ => return writes(), // a host without edit blocks: plain writes
         };
         let label = cstr(name);
         // SAFETY: the instance's param set and a NUL-terminated label.
-        check(unsafe { begin(self.set, label.as_ptr()) }, "paramEditBegin")?;
+        check(
+            unsafe { begin(self.set.set, label.as_ptr()) },
+            "paramEditBegin",
+        )?;
         let result = writes();
         // SAFETY: closes the block opened just above on the same set.
-        let closed = check(unsafe { end(self.set) }, "paramEditEnd");
+        let closed = check(unsafe { end(self.set.set) }, "paramEditEnd");
         let value = result?;
         closed.map(|()| value)
     }

@@ -34,7 +34,13 @@ macro_rules! call {
 }
 
 impl PropSet {
-    pub fn new(handle: OfxPropertySetHandle) -> Outcome<Self> {
+    /// The property set behind a host's handle.
+    ///
+    /// # Safety
+    /// `handle` is null (refused) or a property set handle the host gave us
+    /// (an action's arguments, or a suite call's answer), valid for as long
+    /// as the returned value is used.
+    pub unsafe fn from_raw(handle: OfxPropertySetHandle) -> Outcome<Self> {
         if handle.is_null() {
             return Err(Failure::Status(
                 kOfxStatErrBadHandle,
@@ -47,7 +53,7 @@ impl PropSet {
         })
     }
 
-    pub fn handle(&self) -> OfxPropertySetHandle {
+    pub(super) fn handle(&self) -> OfxPropertySetHandle {
         self.handle
     }
 
