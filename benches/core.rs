@@ -8,9 +8,11 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
+use morphfx::choice::Choice;
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::resample::{resample, ResampleSettings};
+use morphfx::image::WarpMap;
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::morph::{dissolve, Warped};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
@@ -19,7 +21,7 @@ use morphfx::warp::auto::{self, AutoSettings, WorkImage};
 use morphfx::warp::field::{Evaluation, FieldSettings, FieldWarp, LinePair};
 use morphfx::warp::mesh::{self, Mesh, MeshWarp};
 use morphfx::warp::triangles::TriangleWarp;
-use morphfx::warp::{Warp, WarpMap};
+use morphfx::warp::Warp;
 
 const W: i32 = 1920;
 const H: i32 = 1080;
@@ -375,7 +377,13 @@ fn bench_scattered(c: &mut Criterion) {
     });
     g.bench_function("hybrid_solve_and_map", |b| {
         b.iter(|| {
-            let m = hybrid::solve(&pairs, full, &hybrid::HybridSettings::default());
+            let m = hybrid::solve(
+                &pairs,
+                full,
+                &hybrid::HybridSettings::default(),
+                &morphfx::warp::thin_plate::ThinPlateSettings::default(),
+                &morphfx::warp::mffd::MffdSettings::default(),
+            );
             black_box(MffdWarp { mffd: m }.map_window(frame(), PixelScale::UNIT))
         })
     });

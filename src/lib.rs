@@ -10,10 +10,12 @@
 #![forbid(unsafe_code)]
 
 pub mod bspline;
+pub mod choice;
 pub mod error;
 pub mod features;
 pub mod geom;
 pub mod image;
+pub mod make_warp;
 pub mod morph;
 pub mod scene;
 pub mod snake;

@@ -3,9 +3,9 @@
 
 use crate::image::bilinear_rgba::{blend_row, Taps};
 use crate::image::resample::{adapt_channels, fill_rows, map_span, row_through};
+use crate::image::WarpMap;
 use crate::image::{Plane, RowsMut, Sample, Sampler};
 use crate::transition::Weights;
-use crate::warp::WarpMap;
 
 /// A warped source as the dissolve reads it: resampled through a reverse
 /// map, or pixels a warp made directly (the two-pass mesh warp).

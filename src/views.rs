@@ -2,11 +2,12 @@
 //! features drawn on it, and the transition rate as grey. All are consumers of
 //! the same warp maps as the morph itself.
 
+use crate::choice::Choice;
 use crate::features::{sample_points, Feature, FeatureKind};
 use crate::geom::Vec2;
+use crate::image::WarpMap;
 use crate::image::{resample::fill, RowsMut, Sample};
 use crate::transition::Rates;
-use crate::warp::WarpMap;
 
 /// The output view a node renders (CONTRACT §3 `--view`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -21,8 +22,8 @@ pub enum View {
     Grid,
 }
 
-impl View {
-    pub const ALL: [View; 7] = [
+impl Choice for View {
+    const ALL: &'static [View] = &[
         View::Morph,
         View::WarpedA,
         View::WarpedB,
@@ -31,7 +32,7 @@ impl View {
         View::Transition,
         View::Grid,
     ];
-    pub fn name(self) -> &'static str {
+    fn name(self) -> &'static str {
         match self {
             View::Morph => "morph",
             View::WarpedA => "warped-a",
@@ -41,9 +42,6 @@ impl View {
             View::Transition => "transition",
             View::Grid => "grid",
         }
-    }
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|v| v.name() == s)
     }
 }
 

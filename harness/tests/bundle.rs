@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 mod common;
 
+use morphfx::choice::Choice;
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::{EdgeMode, Filter, Image, Sampler};
@@ -66,7 +67,7 @@ enum Method {
     /// Found from the two sources (work minimisation).
     Auto,
     /// The scene text's features as point pairs: thin-plate, mffd or hybrid.
-    Scattered(morphfx::scene::Method),
+    Scattered(morphfx::make_warp::Method),
 }
 
 /// A 4 × 4 mesh on `bounds` (canonical at full resolution), its inner
@@ -277,12 +278,14 @@ fn expected(case: &Case, a: &Image, b: &Image) -> Image {
             .unwrap()
             .map_window(full, scale),
         Method::Scattered(m) => {
-            let settings = morphfx::warp::WarpSettings {
-                method: m,
-                frame: Some(frame),
-                ..Default::default()
+            let settings = morphfx::make_warp::WarpSettings {
+                region: Some(frame),
+                ..morphfx::make_warp::WarpSettings::new(morphfx::make_warp::MethodSettings {
+                    method: m,
+                    ..Default::default()
+                })
             };
-            morphfx::warp::toward(&f, side, T, &settings)
+            morphfx::make_warp::toward(&f, side, T, &settings)
                 .unwrap()
                 .map_window(full, scale)
         }
@@ -525,9 +528,9 @@ fn mesh_triangle_scattered_and_auto_renders_match_the_core_at_every_depth_scale_
     for method in [
         Method::Mesh,
         Method::Triangles,
-        Method::Scattered(morphfx::scene::Method::ThinPlate),
-        Method::Scattered(morphfx::scene::Method::Mffd),
-        Method::Scattered(morphfx::scene::Method::Hybrid),
+        Method::Scattered(morphfx::make_warp::Method::ThinPlate),
+        Method::Scattered(morphfx::make_warp::Method::Mffd),
+        Method::Scattered(morphfx::make_warp::Method::Hybrid),
         Method::Auto,
     ] {
         for depth in DEPTHS {

@@ -8,9 +8,9 @@ mod common;
 use morphfx::features::Side;
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::Image;
+use morphfx::make_warp::{self, WarpSettings};
 use morphfx::scene::Scene;
 use morphfx::testing::texture;
-use morphfx::warp::{self, WarpSettings};
 use morphfx_harness::io;
 
 const W: usize = 128;
@@ -75,10 +75,10 @@ fn scattered_methods_render_through_the_plugin_as_the_core_does() {
         let parsed = Scene::parse(&scene).unwrap();
         let features = parsed.features_at(0.0);
         let settings = WarpSettings {
-            frame: Some(RectD::new(0.0, 0.0, W as f64, H as f64)),
-            ..WarpSettings::from_scene(&parsed, 0.0)
+            region: Some(RectD::new(0.0, 0.0, W as f64, H as f64)),
+            ..parsed.warp_settings_at(0.0)
         };
-        let core = warp::toward(&features, Side::A, 0.5, &settings).unwrap();
+        let core = make_warp::toward(&features, Side::A, 0.5, &settings).unwrap();
         let map = core.map_window(RectI::from_size(W, H), PixelScale::new(1.0, 1.0, 1.0));
         let at = |i: i32, j: i32| {
             let q = st.pixel(i, j);

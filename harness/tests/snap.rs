@@ -61,7 +61,7 @@ fn snap_moves_curves_onto_the_edges_of_each_plate_and_keeps_the_rest() {
     // Untouched: the point feature and the field settings.
     let original = Scene::parse(SCENE).unwrap();
     assert_eq!(scene.features[1], original.features[1]);
-    assert_eq!(scene.field, original.field);
+    assert_eq!(scene.settings.field, original.settings.field);
 }
 
 #[test]

@@ -7,8 +7,8 @@ use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 use std::sync::{Arc, Mutex};
 
+use morphfx::image::WarpMap;
 use morphfx::warp::auto::Correspondence;
-use morphfx::warp::WarpMap;
 
 /// Default memory budget for cached maps (a 1080p map is 16 MiB).
 pub const DEFAULT_BUDGET_BYTES: usize = 512 << 20;

@@ -8,9 +8,11 @@
 pub(crate) mod bilinear_rgba;
 pub mod resample;
 mod sample;
+mod warp_map;
 
 pub use resample::{resample, ResampleSettings};
 pub use sample::{EdgeMode, Filter, Sampler};
+pub use warp_map::WarpMap;
 
 use crate::error::{Error, Result};
 use crate::geom::RectI;

@@ -3,9 +3,9 @@
 
 use rayon::prelude::*;
 
+use super::WarpMap;
 use super::{EdgeMode, Filter, ImageView, RowsMut, Sample, Sampler};
 use crate::geom::PixelScale;
-use crate::warp::WarpMap;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct ResampleSettings {

@@ -5,6 +5,7 @@ use wide::f32x8;
 
 use super::bilinear_rgba::{self, Taps};
 use super::{ImageView, Sample};
+use crate::choice::Choice;
 use crate::geom::{PixelScale, RectI};
 
 /// Reconstruction filter.
@@ -18,17 +19,13 @@ pub enum Filter {
     Bicubic,
 }
 
-impl Filter {
-    pub fn name(self) -> &'static str {
+impl Choice for Filter {
+    const ALL: &'static [Self] = &[Filter::Bilinear, Filter::Bicubic];
+    fn name(self) -> &'static str {
         match self {
             Filter::Bilinear => "bilinear",
             Filter::Bicubic => "bicubic",
         }
-    }
-    pub fn parse(s: &str) -> Option<Self> {
-        [Filter::Bilinear, Filter::Bicubic]
-            .into_iter()
-            .find(|f| f.name() == s)
     }
 }
 
@@ -44,20 +41,19 @@ pub enum EdgeMode {
     Mirror,
 }
 
-impl EdgeMode {
-    pub fn name(self) -> &'static str {
+impl Choice for EdgeMode {
+    /// In the order the nodes' Edge param has always listed them.
+    const ALL: &'static [Self] = &[EdgeMode::Clamp, EdgeMode::Black, EdgeMode::Mirror];
+    fn name(self) -> &'static str {
         match self {
             EdgeMode::Black => "black",
             EdgeMode::Clamp => "clamp",
             EdgeMode::Mirror => "mirror",
         }
     }
-    pub fn parse(s: &str) -> Option<Self> {
-        [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror]
-            .into_iter()
-            .find(|m| m.name() == s)
-    }
+}
 
+impl EdgeMode {
     /// The in-bounds index `k` reads from, for an axis `[lo, hi)`.
     #[inline]
     pub(crate) fn resolve(self, k: i32, lo: i32, hi: i32) -> Option<i32> {

@@ -2,7 +2,7 @@ use super::*;
 use crate::features::{Feature, Side};
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::{EdgeMode, Filter, Image, Sampler};
-use crate::warp::{self, WarpSettings};
+use crate::make_warp::{self, WarpSettings};
 
 fn plates() -> (Image, Image) {
     let b = RectI::from_size(40, 30);
@@ -18,10 +18,10 @@ fn plates() -> (Image, Image) {
 fn render(t: f64, features: &[Feature]) -> Image {
     let (a, b) = plates();
     let s = WarpSettings::default();
-    let wa = warp::toward(features, Side::A, t, &s)
+    let wa = make_warp::toward(features, Side::A, t, &s)
         .unwrap()
         .map_window(a.bounds, PixelScale::UNIT);
-    let wb = warp::toward(features, Side::B, t, &s)
+    let wb = make_warp::toward(features, Side::B, t, &s)
         .unwrap()
         .map_window(a.bounds, PixelScale::UNIT);
     let sa = Sampler::new(

@@ -6,63 +6,11 @@ mod scattered;
 #[cfg(test)]
 mod tests;
 
-use crate::features::{Feature, DEFAULT_SAMPLES_PER_SEGMENT};
-use crate::transition::TransitionSettings;
-use crate::warp::auto::AutoSettings;
-use crate::warp::field::FieldSettings;
-use crate::warp::hybrid::HybridSettings;
-use crate::warp::mesh::{MeshPair, MeshSettings};
-use crate::warp::mffd::MffdSettings;
-use crate::warp::thin_plate::ThinPlateSettings;
+use crate::features::Feature;
+use crate::make_warp::{MethodSettings, WarpSettings};
+use crate::warp::mesh::MeshPair;
 
 pub use parse::FORMAT;
-
-/// The warp generator a scene asks for (CONTRACT §2 `method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum Method {
-    #[default]
-    Field,
-    Mesh,
-    Triangles,
-    ThinPlate,
-    Mffd,
-    Hybrid,
-    Auto,
-}
-
-impl Method {
-    pub const ALL: [Method; 7] = [
-        Method::Field,
-        Method::Mesh,
-        Method::Triangles,
-        Method::ThinPlate,
-        Method::Mffd,
-        Method::Hybrid,
-        Method::Auto,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Field => "field",
-            Method::Mesh => "mesh",
-            Method::Triangles => "triangles",
-            Method::ThinPlate => "thin-plate",
-            Method::Mffd => "mffd",
-            Method::Hybrid => "hybrid",
-            Method::Auto => "auto",
-        }
-    }
-
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s)
-    }
-
-    /// Methods that cannot do anything without features (`auto` finds its own
-    /// correspondence, `mesh` takes its own mesh).
-    pub fn needs_features(self) -> bool {
-        !matches!(self, Method::Auto | Method::Mesh)
-    }
-}
 
 /// A feature set at one frame of an image sequence.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,23 +21,12 @@ pub struct Keyframe {
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
-    pub method: Method,
-    pub field: FieldSettings,
-    /// Mesh method settings (scene key `mesh`).
-    pub mesh: MeshSettings,
+    /// The method and its settings (scene keys `method`, `field`, `mesh`,
+    /// `auto`, `thin-plate`, `mffd`, `hybrid`, `transition`, `sampling`).
+    pub settings: MethodSettings,
     /// The mesh pair: one static pair, or pairs keyed at frames (sorted,
     /// strictly increasing), interpolated like feature keyframes.
     pub meshes: Vec<(f64, MeshPair)>,
-    /// Settings of `auto` (scene key `auto`).
-    pub auto: AutoSettings,
-    /// Settings of `thin-plate`, `mffd` and `hybrid` (scene keys of those names).
-    pub thin_plate: ThinPlateSettings,
-    pub mffd: MffdSettings,
-    pub hybrid: HybridSettings,
-    /// Transition control (scene key `transition`).
-    pub transition: TransitionSettings,
-    /// Samples per polyline/curve span for point-based methods (Lee, Wolberg et al. §4.2).
-    pub samples_per_segment: usize,
     /// The features when there are no keyframes.
     pub features: Vec<Feature>,
     /// Sorted by frame, strictly increasing; when non-empty it replaces `features`.
@@ -104,16 +41,8 @@ pub struct Scene {
 impl Default for Scene {
     fn default() -> Self {
         Scene {
-            method: Method::Field,
-            field: FieldSettings::default(),
-            mesh: MeshSettings::default(),
+            settings: MethodSettings::default(),
             meshes: Vec::new(),
-            auto: AutoSettings::default(),
-            thin_plate: ThinPlateSettings::default(),
-            mffd: MffdSettings::default(),
-            hybrid: HybridSettings::default(),
-            transition: TransitionSettings::default(),
-            samples_per_segment: DEFAULT_SAMPLES_PER_SEGMENT,
             features: Vec::new(),
             keyframes: Vec::new(),
             progress: Vec::new(),
@@ -160,6 +89,14 @@ impl Scene {
         } else {
             keys[lo].1.lerp(&keys[hi].1, w)
         })
+    }
+
+    /// The scene's settings with its mesh pair at `frame`.
+    pub fn warp_settings_at(&self, frame: f64) -> WarpSettings {
+        WarpSettings {
+            meshes: self.mesh_at(frame),
+            ..WarpSettings::new(self.settings.clone())
+        }
     }
 
     /// Progress `t` at `frame`, if the scene keys it (linear between keys, held outside).

@@ -4,10 +4,12 @@
 use serde::Deserialize;
 use serde_json::{Map, Value};
 
-use super::{Keyframe, Method, Scene};
+use super::{Keyframe, Scene};
+use crate::choice::Choice;
 use crate::error::{Error, Result};
 use crate::features::{Feature, FeatureKind};
 use crate::geom::Vec2;
+use crate::make_warp::{Method, MethodSettings};
 use crate::warp::auto::grid::MAX_LEVEL;
 use crate::warp::auto::{AutoSettings, Coefficients, Grid};
 use crate::warp::field::{Evaluation, FieldSettings, LineInterpolation};
@@ -124,10 +126,12 @@ impl Scene {
         let method = match &raw.method {
             None => Method::Field,
             Some(m) => Method::parse(m).ok_or_else(|| {
-                let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
                 Error::scene(
                     "method",
-                    format!("unknown method \"{m}\" (one of {})", names.join(", ")),
+                    format!(
+                        "unknown method \"{m}\" (one of {})",
+                        Method::names().join(", ")
+                    ),
                 )
             })?,
         };
@@ -178,16 +182,18 @@ impl Scene {
             keyframes.first().map_or(&features, |k| &k.features),
         )?;
         let scene = Scene {
-            method,
-            field,
-            mesh,
+            settings: MethodSettings {
+                method,
+                field,
+                mesh,
+                auto,
+                thin_plate: scattered.thin_plate,
+                mffd: scattered.mffd,
+                hybrid: scattered.hybrid,
+                transition: scattered.transition,
+                samples_per_segment,
+            },
             meshes,
-            auto,
-            thin_plate: scattered.thin_plate,
-            mffd: scattered.mffd,
-            hybrid: scattered.hybrid,
-            transition: scattered.transition,
-            samples_per_segment,
             features,
             keyframes,
             progress,

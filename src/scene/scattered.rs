@@ -7,10 +7,11 @@ use serde_json::{Map, Value};
 
 use super::parse::in_range;
 use crate::bspline::mba::MbaSettings;
+use crate::choice::Choice;
 use crate::error::{Error, Result};
 use crate::features::Feature;
 use crate::geom::Vec2;
-use crate::transition::procedural::MAX_SPREAD;
+use crate::transition::procedural::{PatternKind, MAX_SPREAD};
 use crate::transition::{
     Attach, Attached, Curve, Pattern, Procedural, Propagation, Transition, TransitionSettings,
 };
@@ -102,8 +103,6 @@ pub fn read(extra: &mut Map<String, Value>, features: &[Feature]) -> Result<Scat
             Some(raw) => in_range(raw.cell, d.cell, 2.0..=256.0, "hybrid.cell")?,
             None => d.cell,
         },
-        thin_plate,
-        mffd,
     };
     let transition = match take::<RawTransitions>(extra, "transition")? {
         Some(raw) => TransitionSettings {
@@ -252,22 +251,24 @@ fn transition(raw: RawTransition, at: &str, features: &[Feature]) -> Result<Tran
             refuse(&curve_keys)?;
             let cycles = in_range(raw.cycles, 2.0, 0.0..=100.0, &format!("{at}.cycles"))?;
             let angle = in_range(raw.angle, 0.0, -360.0..=360.0, &format!("{at}.angle"))?;
-            let pattern = match raw.pattern.as_deref().unwrap_or("ramp") {
-                "ramp" => Pattern::Ramp { angle },
-                "sine-rows" => Pattern::SineRows { cycles },
-                "sine-columns" => Pattern::SineColumns { cycles },
-                "radial" => Pattern::Radial {
+            let name = raw.pattern.as_deref().unwrap_or("ramp");
+            let kind = PatternKind::parse(name).ok_or_else(|| {
+                Error::scene(
+                    format!("{at}.pattern"),
+                    format!(
+                        "unknown pattern \"{name}\" ({})",
+                        PatternKind::names().join(", ")
+                    ),
+                )
+            })?;
+            let pattern = match kind {
+                PatternKind::Ramp => Pattern::Ramp { angle },
+                PatternKind::SineRows => Pattern::SineRows { cycles },
+                PatternKind::SineColumns => Pattern::SineColumns { cycles },
+                PatternKind::Radial => Pattern::Radial {
                     cycles: in_range(raw.cycles, 0.0, 0.0..=100.0, &format!("{at}.cycles"))?,
                     centre: raw.centre.map(Vec2::from),
                 },
-                other => {
-                    return Err(Error::scene(
-                        format!("{at}.pattern"),
-                        format!(
-                            "unknown pattern \"{other}\" (ramp, sine-rows, sine-columns, radial)"
-                        ),
-                    ))
-                }
             };
             if let Some(c) = raw.centre {
                 if !matches!(pattern, Pattern::Radial { .. }) {

@@ -1,4 +1,5 @@
 use super::*;
+use crate::make_warp::Method;
 use crate::Error;
 
 const GOOD: &str = r#"{
@@ -36,7 +37,7 @@ fn assert_refused(text: &str, at: &str, message: &str) {
 #[test]
 fn parses_the_contract_example() {
     let s = Scene::parse(GOOD).unwrap();
-    assert_eq!(s.method, Method::Field);
+    assert_eq!(s.settings.method, Method::Field);
     assert_eq!(s.features.len(), 4);
     assert_eq!(s.features[2].a.len(), 3);
     assert_eq!(s.features[0].name.as_deref(), Some("nose"));
@@ -165,26 +166,30 @@ fn scattered_method_and_transition_settings_are_read() {
             "colour": {{"type": "procedural", "pattern": "radial", "spread": 0.4, "centre": [5, 6]}}}}}}"#
     );
     let s = Scene::parse(&text).unwrap();
-    assert_eq!(s.method, Method::Hybrid);
+    assert_eq!(s.settings.method, Method::Hybrid);
     assert_eq!(
-        (s.thin_plate.alpha, s.thin_plate.beta, s.thin_plate.cell),
+        (
+            s.settings.thin_plate.alpha,
+            s.settings.thin_plate.beta,
+            s.settings.thin_plate.cell
+        ),
         (40.0, 0.001, 8.0)
     );
     assert_eq!(
-        (s.mffd.coarsest, s.mffd.alpha, s.mffd.tolerance),
+        (
+            s.settings.mffd.coarsest,
+            s.settings.mffd.alpha,
+            s.settings.mffd.tolerance
+        ),
         (3, 0.25, 0.02)
     );
-    assert_eq!(s.hybrid.cell, 32.0);
-    assert_eq!(
-        s.hybrid.thin_plate, s.thin_plate,
-        "hybrid's plate is the thin-plate key's"
-    );
+    assert_eq!(s.settings.hybrid.cell, 32.0);
     let Transition::Curves {
         curves,
         propagation,
-    } = &s.transition.geometry
+    } = &s.settings.transition.geometry
     else {
-        panic!("{:?}", s.transition.geometry)
+        panic!("{:?}", s.settings.transition.geometry)
     };
     assert_eq!(curves[0].attach, Attach::Name("nose".into()));
     assert_eq!(curves[1].attach, Attach::Index(1));
@@ -193,8 +198,8 @@ fn scattered_method_and_transition_settings_are_read() {
     assert!((curves[0].curve.at(0.75) - 0.95).abs() < 1e-12);
     assert_eq!(curves[2].curve.at(0.3), 0.3, "no keys: the uniform rate");
     assert!(matches!(propagation, Propagation::BSpline(m) if m.threshold == 0.01));
-    let Some(Transition::Procedural(p)) = &s.transition.colour else {
-        panic!("{:?}", s.transition.colour)
+    let Some(Transition::Procedural(p)) = &s.settings.transition.colour else {
+        panic!("{:?}", s.settings.transition.colour)
     };
     assert_eq!(p.spread, 0.4);
     assert_eq!(
@@ -312,8 +317,8 @@ fn auto_settings_are_read_and_checked() {
             "warm_start": false, "initial": [[0,0],[50,0],[100,0],[0,50],[60,45],[100,50],[0,100],[50,100],[100,100]]}}"#,
     )
     .unwrap();
-    assert_eq!(s.method, Method::Auto);
-    let a = &s.auto;
+    assert_eq!(s.settings.method, Method::Auto);
+    let a = &s.settings.auto;
     assert_eq!(a.levels, Some(4));
     assert_eq!(
         (
@@ -385,8 +390,8 @@ fn mesh_scenes_parse_with_pass_and_keyframes() {
         mesh_json([12.0, 9.0])
     ))
     .unwrap();
-    assert_eq!(s.method, Method::Mesh);
-    assert_eq!(s.mesh.pass, crate::warp::mesh::Pass::OnePass);
+    assert_eq!(s.settings.method, Method::Mesh);
+    assert_eq!(s.settings.mesh.pass, crate::warp::mesh::Pass::OnePass);
     let pair = s.mesh_at(5.0).unwrap();
     assert_eq!(pair.b.node(1, 1), crate::Vec2::new(12.0, 9.0));
 

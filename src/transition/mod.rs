@@ -18,9 +18,10 @@ use crate::bspline::Lattice;
 use crate::error::{Error, Result};
 use crate::features::{Feature, Side};
 use crate::geom::{RectD, RectI, Vec2};
+use crate::image::WarpMap;
 use crate::warp::node_grid::NodeGrid;
 use crate::warp::thin_plate::{ThinPlate, ThinPlateSettings};
-use crate::warp::{Warp, WarpMap};
+use crate::warp::Warp;
 pub use curve::Curve;
 pub use procedural::{Pattern, Procedural};
 

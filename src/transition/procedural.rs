@@ -12,6 +12,7 @@
 
 use std::f64::consts::TAU;
 
+use crate::choice::Choice;
 use crate::geom::{RectD, Vec2};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +26,33 @@ pub enum Pattern {
     /// Rings around `centre` (canonical; `None`: the frame's centre): the
     /// centre first when `cycles` is 0, else a sinusoid of the radius.
     Radial { cycles: f64, centre: Option<Vec2> },
+}
+
+/// Which pattern, without its numbers: what a scene's `pattern` and the
+/// nodes' Transition param name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PatternKind {
+    Ramp,
+    SineRows,
+    SineColumns,
+    Radial,
+}
+
+impl Choice for PatternKind {
+    const ALL: &'static [Self] = &[
+        PatternKind::Ramp,
+        PatternKind::SineRows,
+        PatternKind::SineColumns,
+        PatternKind::Radial,
+    ];
+    fn name(self) -> &'static str {
+        match self {
+            PatternKind::Ramp => "ramp",
+            PatternKind::SineRows => "sine-rows",
+            PatternKind::SineColumns => "sine-columns",
+            PatternKind::Radial => "radial",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,8 +2,7 @@ use super::procedural::MAX_SPREAD;
 use super::*;
 use crate::features::{Feature, Side};
 use crate::geom::{PixelScale, RectD, RectI, Vec2};
-use crate::scene::Method;
-use crate::warp::{self, WarpSettings};
+use crate::make_warp::{self, Method, MethodSettings, WarpSettings};
 
 const FRAME: RectD = RectD {
     x1: 0.0,
@@ -170,10 +169,12 @@ fn procedural_rates_are_a_at_zero_and_b_at_one() {
 
 fn settings(method: Method, transition: TransitionSettings) -> WarpSettings {
     WarpSettings {
-        method,
-        frame: Some(FRAME),
-        transition,
-        ..WarpSettings::default()
+        region: Some(FRAME),
+        ..WarpSettings::new(MethodSettings {
+            method,
+            transition,
+            ..MethodSettings::default()
+        })
     }
 }
 
@@ -195,8 +196,8 @@ fn geometry_rates_move_each_feature_point_at_its_own_pace() {
         } else {
             0.05
         };
-        let wa = warp::toward(&fs, Side::A, 0.5, &s).unwrap();
-        let wb = warp::toward(&fs, Side::B, 0.5, &s).unwrap();
+        let wa = make_warp::toward(&fs, Side::A, 0.5, &s).unwrap();
+        let wb = make_warp::toward(&fs, Side::B, 0.5, &s).unwrap();
         assert!(
             wa.map(mid).distance(eye.a[0]) < tolerance,
             "{method:?} A: {:?}",
@@ -229,7 +230,7 @@ fn colour_weights_carry_t0_to_b_through_w1() {
     let s = settings(Method::Triangles, transition);
     let t = 0.5;
     let rates = s.colour_rates(&fs, t).unwrap();
-    let w1 = warp::toward(&fs, Side::A, 1.0, &s).unwrap();
+    let w1 = make_warp::toward(&fs, Side::A, 1.0, &s).unwrap();
     let window = RectI::new(0, 0, 2, 1);
     let scale = PixelScale::new(1.0, 1.0, 1.0);
     let eye = &fs[1];
@@ -237,7 +238,7 @@ fn colour_weights_carry_t0_to_b_through_w1() {
     // Two output pixels that see the given source positions.
     let map = |p: Vec2, q: Vec2| {
         let at = |v: Vec2| [v.x as f32, v.y as f32];
-        crate::warp::WarpMap::new(window, scale, vec![at(p), at(q)])
+        crate::image::WarpMap::new(window, scale, vec![at(p), at(q)])
     };
     let map_a = map(eye.a[0], mouth);
     let map_b = map(eye.b[0], fs[0].b[1]);

@@ -1,6 +1,6 @@
 //! The hybrid method (Lee, Wolberg et al. §5.5): the thin plate solved on a coarse grid
 //! gives the global shape cheaply; a cubic B-spline through its nodes carries
-//! it to every point (C², seed: "B-spline propagation"); MFFD then starts
+//! it to every point (C², their "B-spline propagation"); MFFD then starts
 //! from that warp, on lattices no coarser than the plate's grid, to meet the
 //! constraints exactly.
 
@@ -9,32 +9,36 @@ use super::thin_plate::{ThinPlate, ThinPlateSettings};
 use crate::bspline::mba::{self, MbaSettings};
 use crate::geom::{RectD, Vec2};
 
+/// What the hybrid adds to the thin-plate and MFFD settings it uses.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HybridSettings {
-    /// The plate's node spacing (canonical px; seed: a 128² grid for 512²).
+    /// The plate's node spacing (canonical px; Lee, Wolberg et al. use a
+    /// 128² grid for a 512² image).
     pub cell: f64,
-    pub thin_plate: ThinPlateSettings,
-    pub mffd: MffdSettings,
 }
 
 impl Default for HybridSettings {
     fn default() -> Self {
-        HybridSettings {
-            cell: 16.0,
-            thin_plate: ThinPlateSettings::default(),
-            mffd: MffdSettings::default(),
-        }
+        HybridSettings { cell: 16.0 }
     }
 }
 
-/// The hybrid warp: the propagated plate first, then the MFFD steps.
-pub fn solve(pairs: &[(Vec2, Vec2)], frame: RectD, s: &HybridSettings) -> Mffd {
+/// The hybrid warp: the propagated plate first, then the MFFD steps. The
+/// plate and MFFD take the settings of the methods of those names (the
+/// plate on the hybrid's own coarse grid).
+pub fn solve(
+    pairs: &[(Vec2, Vec2)],
+    frame: RectD,
+    s: &HybridSettings,
+    thin_plate: &ThinPlateSettings,
+    mffd: &MffdSettings,
+) -> Mffd {
     let plate = ThinPlate::solve(
         pairs,
         frame,
         &ThinPlateSettings {
             cell: s.cell,
-            ..s.thin_plate
+            ..*thin_plate
         },
         None,
     );
@@ -67,5 +71,5 @@ pub fn solve(pairs: &[(Vec2, Vec2)], frame: RectD, s: &HybridSettings) -> Mffd {
     } else {
         vec![Deformation::new(dx, dy)]
     };
-    Mffd::solve_from(first, pairs, frame, s.cell, &s.mffd)
+    Mffd::solve_from(first, pairs, frame, s.cell, mffd)
 }

@@ -10,9 +10,10 @@
 //! finer one when a step gains less than `α (0.48 h)²` in squared error (§5.4).
 
 use super::node_grid::NodeGrid;
-use super::{Warp, WarpMap};
+use super::Warp;
 use crate::bspline::{basis, Approximation, Lattice};
 use crate::geom::{PixelScale, RectD, RectI, Vec2};
+use crate::image::WarpMap;
 use wide::f64x4;
 
 /// Theorem 1's bound on a control displacement, in lattice spacings.

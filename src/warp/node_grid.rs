@@ -4,8 +4,8 @@
 
 use rayon::prelude::*;
 
-use super::WarpMap;
 use crate::geom::{PixelScale, RectI, Vec2};
+use crate::image::WarpMap;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeGrid {

@@ -18,7 +18,8 @@ use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 use crate::error::{Error, Result};
 use crate::features::{Feature, Side, Tween};
 use crate::geom::{PixelScale, RectD, RectI, Vec2};
-use crate::warp::{Warp, WarpMap};
+use crate::image::WarpMap;
+use crate::warp::Warp;
 
 /// Border points per side of the frame, corners included.
 pub const BORDER_POINTS: usize = 9;

@@ -1,9 +1,14 @@
 //! The params both nodes share, as one table, and their values read at a time.
 
+use std::cell::RefCell;
+use std::sync::OnceLock;
+
+use morphfx::choice::Choice;
 use morphfx::features::Feature;
 use morphfx::geom::Vec2;
 use morphfx::image::{EdgeMode, Filter};
-use morphfx::scene::Method;
+use morphfx::make_warp::{Method, MethodSettings};
+use morphfx::transition::procedural::PatternKind;
 use morphfx::transition::{Pattern, Procedural, Transition, TransitionSettings};
 use morphfx::views::View;
 use morphfx::warp::auto::grid::MAX_LEVEL;
@@ -16,6 +21,7 @@ use morphfx::warp::thin_plate::ThinPlateSettings;
 use super::spec::{Kind, ParamSpec, TextMode};
 use super::NodeKind;
 use crate::wrapper::params::Params;
+use crate::wrapper::Outcome;
 
 /// Line-pair slots every node offers.
 pub const LINE_SLOTS: usize = 16;
@@ -56,9 +62,6 @@ pub const TRANSITION_SPREAD: &str = "transition_spread";
 pub const TRANSITION_ANGLE: &str = "transition_angle";
 pub const TRANSITION_CYCLES: &str = "transition_cycles";
 
-/// The procedural transitions the node offers (curves come from the scene).
-const TRANSITIONS: [&str; 5] = ["uniform", "ramp", "sine-rows", "sine-columns", "radial"];
-
 /// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
 pub fn slot_ids(k: usize) -> [String; 5] {
     [
@@ -73,27 +76,18 @@ pub fn slot_ids(k: usize) -> [String; 5] {
 /// The methods a node offers, in choice order (hosts save the index: only
 /// ever append). Auto finds its warp from both pictures, so the Warp node,
 /// which has one, stops before it; auto is last, so no index moves.
-fn method_options(kind: NodeKind) -> Vec<&'static str> {
-    Method::ALL
-        .iter()
-        .filter(|m| kind == NodeKind::Morph || **m != Method::Auto)
-        .map(|m| match m {
-            Method::Field => "field",
-            Method::Mesh => "mesh",
-            Method::Triangles => "triangles",
-            Method::ThinPlate => "thin-plate",
-            Method::Mffd => "mffd",
-            Method::Hybrid => "hybrid",
-            Method::Auto => "auto",
-        })
-        .collect()
+fn methods(kind: NodeKind) -> &'static [Method] {
+    match kind {
+        NodeKind::Morph => Method::ALL,
+        NodeKind::Warp => &Method::ALL[..Method::ALL.len() - 1],
+    }
 }
 
 /// The views a node offers, in the order of its View choice.
-pub fn views(kind: NodeKind) -> Vec<View> {
+pub fn views(kind: NodeKind) -> &'static [View] {
     match kind {
-        NodeKind::Morph => View::ALL.to_vec(),
-        NodeKind::Warp => vec![View::WarpedA, View::StmapA, View::Grid],
+        NodeKind::Morph => View::ALL,
+        NodeKind::Warp => &[View::WarpedA, View::StmapA, View::Grid],
     }
 }
 
@@ -105,12 +99,90 @@ fn view_label(kind: NodeKind, v: View) -> &'static str {
     }
 }
 
-pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
+/// The Transition param's options: uniform, then each procedural pattern
+/// (curves come from the scene).
+const PATTERNS: [Option<PatternKind>; 5] = [
+    None,
+    Some(PatternKind::Ramp),
+    Some(PatternKind::SineRows),
+    Some(PatternKind::SineColumns),
+    Some(PatternKind::Radial),
+];
+
+fn pattern_label(p: Option<PatternKind>) -> &'static str {
+    p.map_or("uniform", PatternKind::name)
+}
+
+/// How the field is evaluated (the tolerance is its own param).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum EvaluationMode {
+    Adaptive,
+    Exact,
+}
+
+impl Choice for EvaluationMode {
+    const ALL: &'static [Self] = &[EvaluationMode::Adaptive, EvaluationMode::Exact];
+    fn name(self) -> &'static str {
+        match self {
+            EvaluationMode::Adaptive => "adaptive",
+            EvaluationMode::Exact => "exact",
+        }
+    }
+}
+
+/// What a procedural transition paces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Affects {
+    Both,
+    Geometry,
+    Colour,
+}
+
+impl Choice for Affects {
+    const ALL: &'static [Self] = &[Affects::Both, Affects::Geometry, Affects::Colour];
+    fn name(self) -> &'static str {
+        match self {
+            Affects::Both => "geometry and colour",
+            Affects::Geometry => "geometry",
+            Affects::Colour => "colour",
+        }
+    }
+}
+
+/// A choice param's kind: `options` labelled by `label`, `default` first
+/// unless said otherwise.
+fn choice_of<C: Copy + PartialEq>(
+    options: &[C],
+    label: impl Fn(C) -> &'static str,
+    default: C,
+) -> Kind {
+    Kind::Choice {
+        options: options.iter().map(|o| label(*o)).collect(),
+        default: options.iter().position(|o| *o == default).unwrap_or(0),
+    }
+}
+
+/// A [`Choice`] param's kind, options in [`Choice::ALL`] order.
+fn choice<C: Choice>(default: C) -> Kind {
+    choice_of(C::ALL, C::name, default)
+}
+
+/// The node's params, built once per kind.
+pub fn table(kind: NodeKind) -> &'static [ParamSpec] {
+    static MORPH: OnceLock<Vec<ParamSpec>> = OnceLock::new();
+    static WARP: OnceLock<Vec<ParamSpec>> = OnceLock::new();
+    match kind {
+        NodeKind::Morph => MORPH.get_or_init(|| build_table(kind)),
+        NodeKind::Warp => WARP.get_or_init(|| build_table(kind)),
+    }
+}
+
+fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
     let d = FieldSettings::default();
     let c = Coefficients::default();
     let tp = ThinPlateSettings::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", Kind::Choice { options: method_options(kind), default: 0 }),
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", choice_of(methods(kind), Method::name, Method::Field)),
         ParamSpec::new(
             PROGRESS,
             "Progress",
@@ -123,16 +195,16 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(FIELD_A, "a", "weight = (length^p / (a + dist))^b. Barely above 0 pins pixels on a line to it; larger is smoother.", Kind::Double { default: d.a, min: 1e-6, max: 1000.0, display: (0.0001, 10.0) }).in_group("field_group"),
         ParamSpec::new(FIELD_B, "b", "How fast a line's influence falls off with distance (0.5 to 2 is most useful).", Kind::Double { default: d.b, min: 0.0, max: 10.0, display: (0.0, 4.0) }).in_group("field_group"),
         ParamSpec::new(FIELD_P, "p", "How much longer lines outweigh shorter ones (0: all equal, 1: by length).", Kind::Double { default: d.p, min: 0.0, max: 4.0, display: (0.0, 1.0) }).in_group("field_group"),
-        ParamSpec::new(INTERPOLATION, "Line Interpolation", "endpoints: endpoints move straight; center-angle: centre, angle and length interpolate (rotating lines keep their length).", Kind::Choice { options: vec!["endpoints", "center-angle"], default: 0 }).in_group("field_group"),
-        ParamSpec::new(EVALUATION, "Evaluation", "adaptive: coarse grid refined where needed, within Tolerance of exact; exact: every pixel.", Kind::Choice { options: vec!["adaptive", "exact"], default: 0 }).in_group("field_group"),
+        ParamSpec::new(INTERPOLATION, "Line Interpolation", "endpoints: endpoints move straight; center-angle: centre, angle and length interpolate (rotating lines keep their length).", choice(LineInterpolation::Endpoints)).in_group("field_group"),
+        ParamSpec::new(EVALUATION, "Evaluation", "adaptive: coarse grid refined where needed, within Tolerance of exact; exact: every pixel.", choice(EvaluationMode::Adaptive)).in_group("field_group"),
         ParamSpec::new(TOLERANCE, "Tolerance", "Largest error of the adaptive evaluation, in pixels.", Kind::Double { default: Evaluation::DEFAULT_TOLERANCE, min: 0.001, max: 5.0, display: (0.01, 1.0) }).in_group("field_group").animated(false),
         ParamSpec::new("mesh_group", "Mesh", "Mesh warp (the mesh comes from the scene's \"mesh\" key)", Kind::Group { open: false }),
-        ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", Kind::Choice { options: vec!["two-pass", "one-pass"], default: 0 }).in_group("mesh_group").animated(false),
+        ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", choice(Pass::TwoPass)).in_group("mesh_group").animated(false),
         ParamSpec::new("auto_group", "Auto", "Automatic correspondence by work minimisation (method auto)", Kind::Group { open: false }),
         ParamSpec::new(AUTO_LEVELS, "Levels", "Depth of the search: 2^levels quads per side. 0: quads of about 4 pixels (6 at 256, 8 at HD). Fewer levels are faster and coarser.", Kind::Int { default: 0, min: 0, max: MAX_LEVEL as i32 }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_COLOUR, "Colour Work", "Weight of re-colouring work (c_c): how hard the warp tries to match B's colours.", Kind::Double { default: c.colour, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_STRETCH, "Stretch Work", "Weight of stretching work (c_s). 0 with Angle Work 0 gives a more fluid warp.", Kind::Double { default: c.stretch, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_ANGLE, "Angle Work", "Weight of angle-change work (c_a).", Kind::Double { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_COLOUR, "Colour Work", "How hard the warp tries to match B's colours (the weight of re-colouring work).", Kind::Double { default: c.colour, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_STRETCH, "Stretch Work", "How much the warp resists stretching. 0 with Angle Work 0 gives a more fluid warp.", Kind::Double { default: c.stretch, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_ANGLE, "Angle Work", "How much the warp resists changing angles (shearing).", Kind::Double { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
         ParamSpec::new(AUTO_ANCHORS, "Anchor Weight", "How strongly features (line slots, scene features) hold as anchor points.", Kind::Double { default: c.anchor, min: 0.0, max: 1000.0, display: (0.0, 100.0) }).in_group("auto_group").animated(false),
         ParamSpec::new(AUTO_WARM_START, "Warm Start", "Start each frame from the previous frame's warp when this instance has it: faster, steadier over a sequence; off makes every frame independent of render order.", Kind::Bool { default: true }).in_group("auto_group").animated(false),
         ParamSpec::new("scattered_group", "Thin Plate / MFFD", "Settings of the scattered-feature methods (thin-plate, mffd, hybrid)", Kind::Group { open: false }),
@@ -140,8 +212,8 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(PLATE_BETA, "Glue β", "How soon a feature's pull dies away in the thin plate (px⁻⁴): it reaches about β^(-1/4) px. 0: no glue, the pull spreads over the frame.", Kind::Double { default: tp.beta, min: 0.0, max: 1.0, display: (0.0, 1e-4) }).in_group("scattered_group").animated(false),
         ParamSpec::new(MFFD_ALPHA, "Refine α", "MFFD moves to a finer lattice when a step gains less than α (0.48 h)²: small values keep the deformation coarse and smooth.", Kind::Double { default: MffdSettings::default().alpha, min: 0.0, max: 1.0, display: (0.0, 1.0) }).in_group("scattered_group").animated(false),
         ParamSpec::new("transition_group", "Transition", "How fast each part changes (transition curves come from the scene's \"transition\" key)", Kind::Group { open: false }),
-        ParamSpec::new(TRANSITION, "Transition", "uniform: every pixel at Progress; ramp, sine-rows, sine-columns, radial: each pixel's turn comes from where it is on A, every pixel still exactly A at 0 and B at 1.", Kind::Choice { options: TRANSITIONS.to_vec(), default: 0 }).in_group("transition_group"),
-        ParamSpec::new(TRANSITION_AFFECTS, "Affects", "What the transition paces: the geometry (where features are) and the colour (the dissolve), or one of them (the other stays uniform).", Kind::Choice { options: vec!["geometry and colour", "geometry", "colour"], default: 0 }).in_group("transition_group").animated(false),
+        ParamSpec::new(TRANSITION, "Transition", "uniform: every pixel at Progress; ramp, sine-rows, sine-columns, radial: each pixel's turn comes from where it is on A, every pixel still exactly A at 0 and B at 1.", choice_of(&PATTERNS, pattern_label, None)).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_AFFECTS, "Affects", "What the transition paces: the geometry (where features are) and the colour (the dissolve), or one of them (the other stays uniform).", choice(Affects::Both)).in_group("transition_group").animated(false),
         ParamSpec::new(TRANSITION_SPREAD, "Spread", "Share of the progress over which the pattern sweeps: 0 is uniform; near 1 each pixel changes almost at once, at its turn.", Kind::Double { default: 0.5, min: 0.0, max: 0.99, display: (0.0, 0.99) }).in_group("transition_group"),
         ParamSpec::new(TRANSITION_ANGLE, "Angle", "Direction of the ramp in degrees: 0 left to right, 90 bottom to top.", Kind::Double { default: 0.0, min: -360.0, max: 360.0, display: (-180.0, 180.0) }).in_group("transition_group"),
         ParamSpec::new(TRANSITION_CYCLES, "Cycles", "Sinusoid periods across the frame (sine patterns), or rings (radial; 0: the centre first, then outward).", Kind::Double { default: 2.0, min: 0.0, max: 100.0, display: (0.0, 8.0) }).in_group("transition_group"),
@@ -183,7 +255,7 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(
             "scene_group",
             "Scene",
-            "A MorphFX scene (CONTRACT §2) with keyframed features",
+            "A MorphFX scene (.morph.json) with keyframed features, mesh and settings",
             Kind::Group { open: false },
         ),
         ParamSpec::new(
@@ -242,31 +314,19 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
             FILTER,
             "Filter",
             "bilinear, or bicubic (Catmull-Rom: sharper, may overshoot).",
-            Kind::Choice {
-                options: vec!["bilinear", "bicubic"],
-                default: 0,
-            },
+            choice(Filter::Bilinear),
         ),
         ParamSpec::new(
             EDGE,
             "Edge",
             "Outside the source: clamp to the edge pixels, black (transparent), or mirror.",
-            Kind::Choice {
-                options: vec!["clamp", "black", "mirror"],
-                default: 0,
-            },
+            choice(EdgeMode::Clamp),
         ),
         ParamSpec::new(
             VIEW,
             "View",
             "What the node outputs.",
-            Kind::Choice {
-                options: views(kind)
-                    .into_iter()
-                    .map(|v| view_label(kind, v))
-                    .collect(),
-                default: 0,
-            },
+            choice_of(views(kind), |v| view_label(kind, v), views(kind)[0]),
         ),
     ]);
     t
@@ -276,7 +336,7 @@ pub fn table(kind: NodeKind) -> Vec<ParamSpec> {
 /// transition context the mandated `Transition` param (Parameters Mandated
 /// In A Context: the plugin defines it, the host drives it).
 pub fn table_in_context(kind: NodeKind, context: &str) -> Vec<ParamSpec> {
-    let mut table = table(kind);
+    let mut table = table(kind).to_vec();
     if context == super::render::TRANSITION {
         table.push(ParamSpec::new(
             TRANSITION_PARAM,
@@ -291,20 +351,15 @@ pub fn table_in_context(kind: NodeKind, context: &str) -> Vec<ParamSpec> {
 /// The transition context's mandated param (`kOfxImageEffectTransitionParamName`).
 pub const TRANSITION_PARAM: &str = "Transition";
 
-/// Param values at one time. A param the host cannot read keeps its default
-/// (minimal hosts), and is named in `missing` so it can be reported once.
+/// Param values at one time. A param the host cannot read keeps its
+/// default (minimal hosts), and is named in `missing` so it can be reported
+/// once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
-    pub method: Method,
+    pub warp: MethodSettings,
     pub progress: f64,
     pub use_scene_progress: bool,
     pub settings_from_scene: bool,
-    pub field: FieldSettings,
-    pub mesh: MeshSettings,
-    pub auto: AutoSettings,
-    pub thin_plate: ThinPlateSettings,
-    pub mffd: MffdSettings,
-    pub transition: TransitionSettings,
     pub lines: Vec<Feature>,
     pub scene_file: String,
     pub scene_text: String,
@@ -316,175 +371,386 @@ pub struct Settings {
     pub missing: Vec<String>,
 }
 
+/// Reads params at one time, each by the table entry that defines it: the
+/// default it declares stands in for a value the host cannot give, and its
+/// range bounds the value.
+pub struct Reader<'a> {
+    params: &'a Params,
+    table: &'a [ParamSpec],
+    time: f64,
+    missing: RefCell<Vec<String>>,
+}
+
+impl<'a> Reader<'a> {
+    pub fn new(params: &'a Params, kind: NodeKind, time: f64) -> Self {
+        Reader {
+            params,
+            table: table(kind),
+            time,
+            missing: RefCell::new(Vec::new()),
+        }
+    }
+
+    fn spec(&self, id: &str) -> &'a ParamSpec {
+        self.table
+            .iter()
+            .find(|p| p.id == id)
+            .unwrap_or_else(|| panic!("param {id} is read but not in the node's table"))
+    }
+
+    /// The host's value, or `None` (and `id` noted missing).
+    fn host<T>(&self, id: &str, read: impl FnOnce(&Params) -> Outcome<T>) -> Option<T> {
+        let value = read(self.params).ok();
+        if value.is_none() {
+            self.missing.borrow_mut().push(id.to_owned());
+        }
+        value
+    }
+
+    pub fn double(&self, id: &str) -> f64 {
+        let Kind::Double {
+            default, min, max, ..
+        } = self.spec(id).kind
+        else {
+            panic!("param {id} is not a double");
+        };
+        match self.host(id, |p| p.double(id, self.time)) {
+            Some(v) if v.is_finite() => v.clamp(min, max),
+            _ => default,
+        }
+    }
+
+    pub fn int(&self, id: &str) -> i32 {
+        let Kind::Int { default, min, max } = self.spec(id).kind else {
+            panic!("param {id} is not an integer");
+        };
+        self.host(id, |p| p.int(id, self.time))
+            .map_or(default, |v| v.clamp(min, max))
+    }
+
+    pub fn bool(&self, id: &str) -> bool {
+        let Kind::Bool { default } = self.spec(id).kind else {
+            panic!("param {id} is not a boolean");
+        };
+        self.host(id, |p| p.int(id, self.time))
+            .map_or(default, |v| v != 0)
+    }
+
+    /// The option of `options` the host's index picks (the list the table
+    /// defined the param with), else the declared default.
+    fn pick<C: Copy>(&self, id: &str, options: &[C]) -> C {
+        let Kind::Choice { default, .. } = &self.spec(id).kind else {
+            panic!("param {id} is not a choice");
+        };
+        self.host(id, |p| p.int(id, self.time))
+            .and_then(|i| usize::try_from(i).ok())
+            .and_then(|i| options.get(i))
+            .copied()
+            .unwrap_or(options[*default])
+    }
+
+    /// A [`Choice`] param defined with [`choice`].
+    fn choice<C: Choice>(&self, id: &str) -> C {
+        self.pick(id, C::ALL)
+    }
+
+    pub fn text(&self, id: &str) -> String {
+        let Kind::Text { default, .. } = self.spec(id).kind else {
+            panic!("param {id} is not text");
+        };
+        self.host(id, |p| p.string(id, self.time))
+            .unwrap_or_else(|| default.to_owned())
+    }
+
+    /// A position param, `None` when the host cannot give it.
+    pub fn point(&self, id: &str) -> Option<Vec2> {
+        let Kind::Point { .. } = self.spec(id).kind else {
+            panic!("param {id} is not a position");
+        };
+        self.host(id, |p| p.point(id, self.time))
+            .map(|(x, y)| Vec2::new(x, y))
+    }
+}
+
 impl Settings {
     pub fn read(params: &Params, time: f64, kind: NodeKind) -> Settings {
-        let missing = std::cell::RefCell::new(Vec::new());
-        let f64_or = |id: &str, default: f64| {
-            params.double(id, time).unwrap_or_else(|_| {
-                missing.borrow_mut().push(id.to_owned());
-                default
-            })
-        };
-        let d = FieldSettings::default();
-        let progress = f64_or(PROGRESS, 0.5).clamp(0.0, 1.0);
-        let (a, b, p) = (
-            f64_or(FIELD_A, d.a).max(1e-9),
-            f64_or(FIELD_B, d.b).max(0.0),
-            f64_or(FIELD_P, d.p).max(0.0),
-        );
-        let tolerance = f64_or(TOLERANCE, Evaluation::DEFAULT_TOLERANCE).max(1e-4);
-        let int_or = |id: &str, default: i32| {
-            params.int(id, time).unwrap_or_else(|_| {
-                missing.borrow_mut().push(id.to_owned());
-                default
-            })
-        };
-        let method = Method::ALL[int_or(METHOD, 0).clamp(0, Method::ALL.len() as i32 - 1) as usize];
-        let use_scene_progress = int_or(USE_SCENE_PROGRESS, 1) != 0;
-        let settings_from_scene = int_or(SETTINGS_FROM_SCENE, 1) != 0;
-        let interpolation = if int_or(INTERPOLATION, 0) == 1 {
-            LineInterpolation::CenterAngle
-        } else {
-            LineInterpolation::Endpoints
-        };
-        let evaluation = if int_or(EVALUATION, 0) == 1 {
-            Evaluation::Exact
-        } else {
-            Evaluation::Adaptive { tolerance }
-        };
-        let pass = if int_or(MESH_PASS, 0) == 1 {
-            Pass::OnePass
-        } else {
-            Pass::TwoPass
-        };
-        let c = Coefficients::default();
-        let weight = |id: &str, d: f64| f64_or(id, d).clamp(0.0, 1000.0);
-        let auto = AutoSettings {
-            levels: match int_or(AUTO_LEVELS, 0) {
-                l if l <= 0 => None,
-                l => Some((l as u32).min(MAX_LEVEL)),
+        let r = Reader::new(params, kind, time);
+        let warp = MethodSettings {
+            method: r.pick(METHOD, methods(kind)),
+            field: field_settings(&r),
+            mesh: MeshSettings {
+                pass: r.choice(MESH_PASS),
             },
-            coefficients: Coefficients {
-                colour: weight(AUTO_COLOUR, c.colour),
-                stretch: weight(AUTO_STRETCH, c.stretch),
-                angle: weight(AUTO_ANGLE, c.angle),
-                anchor: weight(AUTO_ANCHORS, c.anchor),
+            auto: auto_settings(&r),
+            thin_plate: ThinPlateSettings {
+                alpha: r.double(PLATE_ALPHA),
+                beta: r.double(PLATE_BETA),
+                ..ThinPlateSettings::default()
             },
-            warm_start: int_or(AUTO_WARM_START, 1) != 0,
-            ..AutoSettings::default()
+            mffd: MffdSettings {
+                alpha: r.double(MFFD_ALPHA),
+                ..MffdSettings::default()
+            },
+            transition: transition_settings(&r),
+            ..MethodSettings::default()
         };
-        let tp = ThinPlateSettings::default();
-        let thin_plate = ThinPlateSettings {
-            alpha: f64_or(PLATE_ALPHA, tp.alpha).clamp(0.01, 1e6),
-            beta: f64_or(PLATE_BETA, tp.beta).clamp(0.0, 1.0),
-            ..tp
-        };
-        let mffd = MffdSettings {
-            alpha: f64_or(MFFD_ALPHA, MffdSettings::default().alpha).clamp(0.0, 1.0),
-            ..MffdSettings::default()
-        };
-        let spread = f64_or(TRANSITION_SPREAD, 0.5).clamp(0.0, 0.99);
-        let cycles = f64_or(TRANSITION_CYCLES, 2.0).clamp(0.0, 100.0);
-        let pattern = match int_or(TRANSITION, 0) {
-            1 => Some(Pattern::Ramp {
-                angle: f64_or(TRANSITION_ANGLE, 0.0),
-            }),
-            2 => Some(Pattern::SineRows { cycles }),
-            3 => Some(Pattern::SineColumns { cycles }),
-            4 => Some(Pattern::Radial {
-                cycles,
-                centre: None,
-            }),
-            _ => None,
-        };
-        let transition = match pattern {
-            None => TransitionSettings::default(),
-            Some(pattern) => {
-                let t = Transition::Procedural(Procedural { pattern, spread });
-                match int_or(TRANSITION_AFFECTS, 0) {
-                    1 => TransitionSettings {
-                        geometry: t,
-                        colour: Some(Transition::Uniform),
-                    },
-                    2 => TransitionSettings {
-                        geometry: Transition::Uniform,
-                        colour: Some(t),
-                    },
-                    _ => TransitionSettings {
-                        geometry: t,
-                        colour: None,
-                    },
-                }
-            }
-        };
-        let count = int_or(LINE_COUNT, 0).clamp(0, LINE_SLOTS as i32) as usize;
-        let offset_a = int_or(OFFSET_A, 0);
-        let offset_b = if kind == NodeKind::Morph {
-            int_or(OFFSET_B, 0)
-        } else {
-            0
-        };
-        let filter = if int_or(FILTER, 0) == 1 {
-            Filter::Bicubic
-        } else {
-            Filter::Bilinear
-        };
-        let edge = [EdgeMode::Clamp, EdgeMode::Black, EdgeMode::Mirror]
-            [int_or(EDGE, 0).clamp(0, 2) as usize];
-        let views = views(kind);
-        let view = views[int_or(VIEW, 0).clamp(0, views.len() as i32 - 1) as usize];
-        let mut lines = Vec::new();
-        for k in 1..=count {
-            let [enable, a0, a1, b0, b1] = slot_ids(k);
-            if int_or(&enable, 1) == 0 {
-                continue;
-            }
-            let pt = |id: &str| params.point(id, time).ok().map(|(x, y)| Vec2::new(x, y));
-            if let (Some(a0), Some(a1), Some(b0), Some(b1)) = (pt(&a0), pt(&a1), pt(&b0), pt(&b1)) {
-                // A zero-length line has no direction: the slot is skipped, not an error,
-                // so a half-placed line never breaks a render.
-                if a0 != a1 && b0 != b1 && [a0, a1, b0, b1].iter().all(|p| p.is_finite()) {
-                    lines.push(Feature::line([a0, a1], [b0, b1]).named(format!("line {k}")));
-                }
+        let settings = Settings {
+            warp,
+            progress: r.double(PROGRESS),
+            use_scene_progress: r.bool(USE_SCENE_PROGRESS),
+            settings_from_scene: r.bool(SETTINGS_FROM_SCENE),
+            lines: lines(&r),
+            scene_file: r.text(SCENE_FILE),
+            scene_text: r.text(SCENE_TEXT),
+            offset_a: r.int(OFFSET_A),
+            offset_b: if kind == NodeKind::Morph {
+                r.int(OFFSET_B)
             } else {
-                missing.borrow_mut().push(format!("line{k}"));
+                0
+            },
+            filter: r.choice(FILTER),
+            edge: r.choice(EDGE),
+            view: r.pick(VIEW, views(kind)),
+            missing: Vec::new(),
+        };
+        Settings {
+            missing: r.missing.into_inner(),
+            ..settings
+        }
+    }
+}
+
+fn field_settings(r: &Reader<'_>) -> FieldSettings {
+    let evaluation = match r.choice(EVALUATION) {
+        EvaluationMode::Exact => Evaluation::Exact,
+        EvaluationMode::Adaptive => Evaluation::Adaptive {
+            tolerance: r.double(TOLERANCE),
+        },
+    };
+    FieldSettings {
+        a: r.double(FIELD_A),
+        b: r.double(FIELD_B),
+        p: r.double(FIELD_P),
+        interpolation: r.choice(INTERPOLATION),
+        evaluation,
+        ..FieldSettings::default()
+    }
+}
+
+fn auto_settings(r: &Reader<'_>) -> AutoSettings {
+    AutoSettings {
+        // 0: the level that gives quads of about 4 pixels.
+        levels: match r.int(AUTO_LEVELS) {
+            0 => None,
+            l => Some(l as u32),
+        },
+        coefficients: Coefficients {
+            colour: r.double(AUTO_COLOUR),
+            stretch: r.double(AUTO_STRETCH),
+            angle: r.double(AUTO_ANGLE),
+            anchor: r.double(AUTO_ANCHORS),
+        },
+        warm_start: r.bool(AUTO_WARM_START),
+        ..AutoSettings::default()
+    }
+}
+
+fn transition_settings(r: &Reader<'_>) -> TransitionSettings {
+    let Some(kind) = r.pick(TRANSITION, &PATTERNS) else {
+        return TransitionSettings::default();
+    };
+    let cycles = r.double(TRANSITION_CYCLES);
+    let pattern = match kind {
+        PatternKind::Ramp => Pattern::Ramp {
+            angle: r.double(TRANSITION_ANGLE),
+        },
+        PatternKind::SineRows => Pattern::SineRows { cycles },
+        PatternKind::SineColumns => Pattern::SineColumns { cycles },
+        PatternKind::Radial => Pattern::Radial {
+            cycles,
+            centre: None,
+        },
+    };
+    let t = Transition::Procedural(Procedural {
+        pattern,
+        spread: r.double(TRANSITION_SPREAD),
+    });
+    match r.choice(TRANSITION_AFFECTS) {
+        Affects::Both => TransitionSettings {
+            geometry: t,
+            colour: None,
+        },
+        Affects::Geometry => TransitionSettings {
+            geometry: t,
+            colour: Some(Transition::Uniform),
+        },
+        Affects::Colour => TransitionSettings {
+            geometry: Transition::Uniform,
+            colour: Some(t),
+        },
+    }
+}
+
+/// The enabled line slots with both lines placed, as features.
+fn lines(r: &Reader<'_>) -> Vec<Feature> {
+    let mut lines = Vec::new();
+    for k in 1..=r.int(LINE_COUNT) as usize {
+        let [enable, a0, a1, b0, b1] = slot_ids(k);
+        if !r.bool(&enable) {
+            continue;
+        }
+        let [a0, a1, b0, b1] = [&a0, &a1, &b0, &b1].map(|id| r.point(id));
+        // A zero-length line has no direction: the slot is skipped, not an
+        // error, so a half-placed line never breaks a render.
+        if let (Some(a0), Some(a1), Some(b0), Some(b1)) = (a0, a1, b0, b1) {
+            if a0 != a1 && b0 != b1 && [a0, a1, b0, b1].iter().all(|p| p.is_finite()) {
+                lines.push(Feature::line([a0, a1], [b0, b1]).named(format!("line {k}")));
             }
         }
-        let text_or = |id: &str| {
-            params.string(id, time).unwrap_or_else(|_| {
-                missing.borrow_mut().push(id.to_owned());
-                String::new()
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every choice param's options as MorphFX 1.0 shipped them. Hosts save
+    /// a choice by its index, so a saved project reads these back by
+    /// position: they may be followed by new options, never reordered,
+    /// renamed or removed.
+    const RELEASED: &[(NodeKind, &str, &[&str])] = &[
+        (
+            NodeKind::Morph,
+            METHOD,
+            &[
+                "field",
+                "mesh",
+                "triangles",
+                "thin-plate",
+                "mffd",
+                "hybrid",
+                "auto",
+            ],
+        ),
+        (
+            NodeKind::Warp,
+            METHOD,
+            &["field", "mesh", "triangles", "thin-plate", "mffd", "hybrid"],
+        ),
+        (
+            NodeKind::Morph,
+            VIEW,
+            &[
+                "morph",
+                "warped-a",
+                "warped-b",
+                "stmap-a",
+                "stmap-b",
+                "transition",
+                "grid",
+            ],
+        ),
+        (NodeKind::Warp, VIEW, &["warped", "stmap", "grid"]),
+    ];
+
+    /// Choice params both nodes share, with their released options.
+    const RELEASED_BOTH: &[(&str, &[&str])] = &[
+        (INTERPOLATION, &["endpoints", "center-angle"]),
+        (EVALUATION, &["adaptive", "exact"]),
+        (MESH_PASS, &["two-pass", "one-pass"]),
+        (
+            TRANSITION,
+            &["uniform", "ramp", "sine-rows", "sine-columns", "radial"],
+        ),
+        (
+            TRANSITION_AFFECTS,
+            &["geometry and colour", "geometry", "colour"],
+        ),
+        (FILTER, &["bilinear", "bicubic"]),
+        (EDGE, &["clamp", "black", "mirror"]),
+    ];
+
+    fn released() -> Vec<(NodeKind, &'static str, &'static [&'static str])> {
+        let mut all = RELEASED.to_vec();
+        for kind in NodeKind::ALL {
+            all.extend(RELEASED_BOTH.iter().map(|(id, o)| (kind, *id, *o)));
+        }
+        all
+    }
+
+    fn options(kind: NodeKind, id: &str) -> Option<(Vec<&'static str>, usize)> {
+        table(kind)
+            .iter()
+            .find(|p| p.id == id)
+            .map(|p| match &p.kind {
+                Kind::Choice { options, default } => (options.clone(), *default),
+                other => panic!("{id} is not a choice: {other:?}"),
             })
-        };
-        let scene_file = text_or(SCENE_FILE);
-        let scene_text = text_or(SCENE_TEXT);
-        Settings {
-            method,
-            progress,
-            use_scene_progress,
-            settings_from_scene,
-            field: FieldSettings {
-                a,
-                b,
-                p,
-                interpolation,
-                evaluation,
-                curve_samples: d.curve_samples,
-            },
-            mesh: MeshSettings { pass },
-            auto,
-            thin_plate,
-            mffd,
-            transition,
-            lines,
-            scene_file,
-            scene_text,
-            offset_a,
-            offset_b,
-            filter,
-            edge,
-            view,
-            missing: missing.into_inner(),
+    }
+
+    #[test]
+    fn choice_options_only_ever_grow_at_the_end() {
+        for (kind, id, was) in released() {
+            let (now, _) = options(kind, id).unwrap_or_else(|| panic!("{kind:?} lost {id}"));
+            assert!(
+                now.starts_with(was),
+                "{kind:?} {id}: released {was:?}, now {now:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn every_choice_param_is_recorded_with_a_default_among_its_options() {
+        let recorded = released();
+        for kind in NodeKind::ALL {
+            for p in table(kind) {
+                if let Kind::Choice { options, default } = &p.kind {
+                    assert!(
+                        recorded.iter().any(|(k, id, _)| *k == kind && *id == p.id),
+                        "{kind:?} {}: record its options in RELEASED",
+                        p.id
+                    );
+                    assert!(*default < options.len(), "{kind:?} {}", p.id);
+                }
+            }
+        }
+    }
+
+    /// The option lists the reader picks from are the ones the table
+    /// defined, so index k reads back the option labelled k.
+    #[test]
+    fn choices_read_back_the_option_they_label() {
+        for kind in NodeKind::ALL {
+            let (labels, _) = options(kind, METHOD).expect("method");
+            let names: Vec<_> = methods(kind).iter().map(|m| m.name()).collect();
+            assert_eq!(labels, names);
+            let (labels, _) = options(kind, VIEW).expect("view");
+            let names: Vec<_> = views(kind).iter().map(|v| view_label(kind, *v)).collect();
+            assert_eq!(labels, names);
+        }
+        assert_eq!(
+            options(NodeKind::Morph, EDGE).expect("edge").0,
+            EdgeMode::names()
+        );
+    }
+
+    #[test]
+    fn ids_are_unique_and_hints_speak_to_compositors() {
+        for kind in NodeKind::ALL {
+            let t = table(kind);
+            for (i, p) in t.iter().enumerate() {
+                assert!(t[i + 1..].iter().all(|q| q.id != p.id), "{} twice", p.id);
+                for stale in ["not yet", "seed", "CONTRACT", "§"] {
+                    assert!(
+                        !p.label.contains(stale) && !p.hint.contains(stale),
+                        "{}: {stale:?} in {:?} / {:?}",
+                        p.id,
+                        p.label,
+                        p.hint
+                    );
+                }
+            }
         }
     }
 }

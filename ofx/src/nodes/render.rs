@@ -5,23 +5,24 @@ use std::sync::{Arc, Mutex};
 
 use morphfx::features::{Feature, Side};
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
+use morphfx::image::WarpMap;
 use morphfx::image::{EdgeMode, ImageView, Layout, Plane, RowsMut, Sample, Sampler};
+use morphfx::make_warp::{self, Method, WarpSettings};
 use morphfx::morph::{dissolve, dissolve_weighted, show, Warped};
-use morphfx::scene::{Method, Scene};
+use morphfx::scene::Scene;
 use morphfx::transition::{self, Rates, Weights};
 use morphfx::views::{self, View};
 use morphfx::warp::auto::{self, Correspondence, WorkImage};
-use morphfx::warp::hybrid::HybridSettings;
 use morphfx::warp::mesh::{self, MeshPair, Pass};
 use morphfx::warp::thin_plate::multigrid::Report;
 use morphfx::warp::thin_plate::ThinPlateWarp;
-use morphfx::warp::{self, Warp, WarpMap, WarpSettings};
+use morphfx::warp::Warp;
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::message::*;
 
 use super::instance::{self, Instance, GRIDS_KEPT, PLANES_KEPT, PLATES_KEPT};
-use super::params::{Settings, OFFSET_A, OFFSET_B, TRANSITION_PARAM};
+use super::params::{Reader, Settings, OFFSET_A, OFFSET_B, TRANSITION_PARAM};
 use super::NodeKind;
 use crate::cache::key_of;
 use crate::wrapper::clips::{Depth, Effect, HostImage, HostSample, ImageInfo};
@@ -65,9 +66,10 @@ fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
     let Ok(params) = instance.params() else {
         return (0.0, 0.0);
     };
-    let a = params.int(OFFSET_A, time).unwrap_or(0) as f64;
+    let r = Reader::new(params, kind, time);
+    let a = r.int(OFFSET_A) as f64;
     let b = if kind == NodeKind::Morph {
-        params.int(OFFSET_B, time).unwrap_or(0) as f64
+        r.int(OFFSET_B) as f64
     } else {
         0.0
     };
@@ -208,8 +210,8 @@ pub fn is_identity(
     let instance = instance::get(effect)?;
     let context = context(effect);
     let settings = Settings::read(instance.params()?, time, kind);
-    let frame = frame_at(kind, &instance, &settings, time, &context)?;
-    let Some(side) = identity_side(kind, settings.view, &frame) else {
+    let inputs = warp_inputs(kind, &instance, &settings, time, &context)?;
+    let Some(side) = identity_side(kind, settings.view, &inputs) else {
         return Ok(Reply::Default);
     };
     let (a, b) = kind.source_clips(&context);
@@ -225,15 +227,16 @@ pub fn is_identity(
     Ok(Reply::Done)
 }
 
-/// Which source the output is at `frame`'s progress, when it is one unchanged.
-fn identity_side(kind: NodeKind, view: View, frame: &Frame) -> Option<Side> {
-    let transition = &frame.warp.transition;
-    if !(transition.geometry.is_uniform_at(frame.t) && transition.colour().is_uniform_at(frame.t)) {
+/// Which source the output is at `inputs`' progress, when it is one unchanged.
+fn identity_side(kind: NodeKind, view: View, inputs: &WarpInputs) -> Option<Side> {
+    let transition = &inputs.warp.settings.transition;
+    if !(transition.geometry.is_uniform_at(inputs.t) && transition.colour().is_uniform_at(inputs.t))
+    {
         return None;
     }
-    let side = if frame.t <= 0.0 {
+    let side = if inputs.t <= 0.0 {
         Side::A
-    } else if frame.t >= 1.0 && kind == NodeKind::Morph {
+    } else if inputs.t >= 1.0 && kind == NodeKind::Morph {
         Side::B
     } else {
         return None;
@@ -279,49 +282,35 @@ fn load_scene(instance: &Instance, settings: &Settings) -> Outcome<Option<Arc<Sc
     Ok(Some(scene))
 }
 
-/// Everything the frame's warps depend on.
+/// Everything the warps at one time depend on.
 #[derive(Debug)]
-struct Frame {
+struct WarpInputs {
     features: Vec<Feature>,
     warp: WarpSettings,
     t: f64,
 }
 
-fn frame_at(
+fn warp_inputs(
     kind: NodeKind,
     instance: &Instance,
     settings: &Settings,
     time: f64,
     context: &str,
-) -> Outcome<Frame> {
+) -> Outcome<WarpInputs> {
     let scene = load_scene(instance, settings)?;
     // The scene's features first, so transition curves attached by index
     // name the scene's own features.
     let mut features = Vec::new();
-    let mut warp = WarpSettings {
-        method: settings.method,
-        field: settings.field,
-        mesh: settings.mesh,
-        auto: settings.auto.clone(),
-        thin_plate: settings.thin_plate,
-        mffd: settings.mffd,
-        hybrid: HybridSettings {
-            thin_plate: settings.thin_plate,
-            mffd: settings.mffd,
-            ..HybridSettings::default()
-        },
-        transition: settings.transition.clone(),
-        ..WarpSettings::default()
-    };
+    let mut warp = WarpSettings::new(settings.warp.clone());
     let mut t = settings.progress;
     if let Some(scene) = &scene {
         features.extend(scene.features_at(time));
         if settings.settings_from_scene {
-            let node_transition = warp.transition.clone();
-            warp = WarpSettings::from_scene(scene, time);
+            let node_transition = warp.settings.transition.clone();
+            warp = scene.warp_settings_at(time);
             // A scene without a transition leaves the node's in place.
-            if warp.transition == Default::default() {
-                warp.transition = node_transition;
+            if warp.settings.transition == Default::default() {
+                warp.settings.transition = node_transition;
             }
         } else {
             warp.meshes = scene.mesh_at(time);
@@ -337,7 +326,7 @@ fn frame_at(
             .double(TRANSITION_PARAM, time)?
             .clamp(0.0, 1.0);
     }
-    Ok(Frame { features, warp, t })
+    Ok(WarpInputs { features, warp, t })
 }
 
 /// A source clip's image, or `None` where the host has none: an unconnected
@@ -357,7 +346,7 @@ const LARGEST_FRAME: f64 = 65536.0;
 
 /// The canonical frame a warp covers: the output's region of definition,
 /// or, where that is infinite or absurdly large, the project.
-fn warp_frame(effect: &Effect, rod: &OfxRectD) -> RectD {
+fn warp_region(effect: &Effect, rod: &OfxRectD) -> RectD {
     let r = RectD::new(rod.x1, rod.y1, rod.x2, rod.y2);
     if r.width() <= LARGEST_FRAME && r.height() <= LARGEST_FRAME && r.is_valid() {
         return r;
@@ -384,7 +373,7 @@ struct Gathered {
     /// The host renders frames in order on this instance (warm starts allowed).
     sequential: bool,
     settings: Settings,
-    frame: Frame,
+    inputs: WarpInputs,
     a: Option<HostImage>,
     b: Option<HostImage>,
     out_info: ImageInfo,
@@ -418,7 +407,7 @@ fn gather(
             ),
         );
     }
-    let frame = frame_at(kind, instance, &settings, time, &context)?;
+    let inputs = warp_inputs(kind, instance, &settings, time, &context)?;
     let (a_name, b_name) = kind.source_clips(&context);
     let a = source(effect, a_name, time + settings.offset_a as f64)?;
     let b = match b_name {
@@ -437,7 +426,7 @@ fn gather(
         window: RectI::new(x1, y1, x2, y2),
         sequential,
         settings,
-        frame,
+        inputs,
         a,
         b,
         out_info,
@@ -491,7 +480,7 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         (None, None) => g.out_info.depth,
     };
     let premultiplied = |s: &Option<HostImage>| s.as_ref().is_none_or(|i| i.info().premultiplied);
-    if g.frame.warp.method == Method::Auto {
+    if g.inputs.warp.method() == Method::Auto {
         let (Some(a_img), Some(b_img)) = (&g.a, &g.b) else {
             return Err(Failure::BadInput(
                 "method \"auto\" finds its warp from two images: connect both sources (Morph node)"
@@ -504,16 +493,16 @@ pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
         ));
         let a_frame = canonical(a_img.info().bounds, a_scale);
         let b_frame = canonical(b_img.info().bounds, b_scale);
-        g.frame.warp.correspondence = Some(correspondence(
+        g.inputs.warp.correspondence = Some(correspondence(
             &instance,
-            &g.frame,
+            &g.inputs,
             (g.time, g.sequential),
             (&a_work, a_frame),
             (&b_work, b_frame),
         )?);
     }
     // Triangles pin the border of the frame, so the whole frame warps.
-    g.frame.warp.frame = Some(warp_frame(effect, &g.rod));
+    g.inputs.warp.region = Some(warp_region(effect, &g.rod));
     if effect.aborted() {
         return Ok(());
     }
@@ -547,25 +536,25 @@ fn prepare<'g>(
     g: &'g Gathered,
     scale: PixelScale,
 ) -> Outcome<Job<'g>> {
-    let frame = &g.frame;
+    let inputs = &g.inputs;
     let view = g.settings.view;
     // The two-pass mesh warp makes pixels (per render window), not a map:
     // pictures take that path, ST maps and the grid the one-pass map.
-    let mesh = frame.warp.method == Method::Mesh;
+    let mesh = inputs.warp.method() == Method::Mesh;
     if mesh {
-        frame.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
+        inputs.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
     }
-    let two_pass = mesh && frame.warp.mesh.pass == Pass::TwoPass;
+    let two_pass = mesh && inputs.warp.settings.mesh.pass == Pass::TwoPass;
     // Maps cover the render window, never more: a tile costs its own pixels,
     // and an infinite region of definition costs nothing extra.
     let map_window = g.window;
     let map = |side: Side| -> Outcome<Arc<WarpMap>> {
-        let key = key_of(&(frame, side, map_window, scale.x, scale.y));
+        let key = key_of(&(inputs, side, map_window, scale.x, scale.y));
         instance.warps.get_or_compute(key, || {
-            let w: Arc<dyn Warp> = if frame.warp.method == Method::ThinPlate {
-                Arc::new(thin_plate(instance, frame, side, (g.time, g.sequential))?)
+            let w: Arc<dyn Warp> = if inputs.warp.method() == Method::ThinPlate {
+                Arc::new(thin_plate(instance, inputs, side, (g.time, g.sequential))?)
             } else {
-                warp::toward(&frame.features, side, frame.t, &frame.warp)?
+                make_warp::toward(&inputs.features, side, inputs.t, &inputs.warp)?
             };
             Ok::<_, Failure>(w.map_window(map_window, scale))
         })
@@ -576,19 +565,25 @@ fn prepare<'g>(
     // A non-uniform colour transition weighs every pixel of the dissolve.
     let weighted = view == View::Morph
         && two_sources
-        && !frame.warp.transition.colour().is_uniform_at(frame.t);
+        && !inputs
+            .warp
+            .settings
+            .transition
+            .colour()
+            .is_uniform_at(inputs.t);
     // The two-pass mesh warp makes pixels, not maps; weights need maps.
     let by_map = !(two_pass && picture) || weighted;
     let weights = if weighted {
         let (ma, mb) = (map(Side::A)?, map(Side::B)?);
-        let key = key_of(&(frame, "weights", map_window, scale.x, scale.y));
+        let key = key_of(&(inputs, "weights", map_window, scale.x, scale.y));
         Some(instance.weights.get_or_compute(key, || {
-            let colour = frame
+            let colour = inputs
                 .warp
-                .colour_rates(&frame.features, frame.t)
+                .colour_rates(&inputs.features, inputs.t)
                 .map_err(bad)?;
             // W1 carries B onto A: the warp of A toward B's positions.
-            let w1 = warp::toward(&frame.features, Side::A, 1.0, &frame.warp).map_err(bad)?;
+            let w1 =
+                make_warp::toward(&inputs.features, Side::A, 1.0, &inputs.warp).map_err(bad)?;
             Ok::<_, Failure>(transition::colour_weights(&colour, &ma, &mb, w1.as_ref()))
         })?)
     } else {
@@ -596,9 +591,9 @@ fn prepare<'g>(
     };
     let rates = if view == View::Transition {
         Some(
-            frame
+            inputs
                 .warp
-                .geometry_rates(&frame.features, frame.t)
+                .geometry_rates(&inputs.features, inputs.t)
                 .map_err(bad)?,
         )
     } else {
@@ -609,8 +604,8 @@ fn prepare<'g>(
         view,
         weights,
         rates,
-        t: frame.t,
-        features: &frame.features,
+        t: inputs.t,
+        features: &inputs.features,
         map_a: if needs_a(view) && by_map {
             Some(map(Side::A)?)
         } else {
@@ -624,7 +619,7 @@ fn prepare<'g>(
         meshes: if by_map {
             None
         } else {
-            frame.warp.meshes.as_ref()
+            inputs.warp.meshes.as_ref()
         },
         planes: &instance.planes,
         premultiply: premultiply(g),
@@ -662,13 +657,13 @@ fn canonical(bounds: RectI, scale: PixelScale) -> RectD {
 /// from the previous frame's grid when this instance solved it.
 fn correspondence(
     instance: &Instance,
-    frame: &Frame,
+    inputs: &WarpInputs,
     (time, sequential): (f64, bool),
     (a, a_frame): (&WorkImage, RectD),
     (b, b_frame): (&WorkImage, RectD),
 ) -> Outcome<Arc<Correspondence>> {
-    let settings = &frame.warp.auto;
-    let per_segment = frame.warp.samples_per_segment;
+    let settings = &inputs.warp.settings.auto;
+    let per_segment = inputs.warp.settings.samples_per_segment;
     let same_setup = key_of(&(
         settings,
         per_segment,
@@ -679,7 +674,7 @@ fn correspondence(
         b.width,
         b.height,
     ));
-    let key = key_of(&(same_setup, a.digest(), b.digest(), &frame.features));
+    let key = key_of(&(same_setup, a.digest(), b.digest(), &inputs.features));
     instance.correspondences.get_or_compute(key, || {
         // Warm starts only in a sequential render: otherwise the result
         // would depend on which frames this instance happened to render.
@@ -698,7 +693,7 @@ fn correspondence(
             a_frame,
             b,
             b_frame,
-            &frame.features,
+            &inputs.features,
             per_segment,
             settings,
             warm.as_ref(),
@@ -736,11 +731,11 @@ fn correspondence(
 /// since features move little from frame to frame.
 fn thin_plate(
     instance: &Instance,
-    frame: &Frame,
+    inputs: &WarpInputs,
     side: Side,
     (time, sequential): (f64, bool),
 ) -> Outcome<ThinPlateWarp> {
-    let setup = key_of(&(side, &frame.warp.thin_plate, frame.warp.frame));
+    let setup = key_of(&(side, &inputs.warp.settings.thin_plate, inputs.warp.region));
     // Warm starts only in a sequential render (see `correspondence`).
     let warm = sequential
         .then(|| {
@@ -752,8 +747,14 @@ fn thin_plate(
                 .map(|(_, _, p)| p.clone())
         })
         .flatten();
-    let w = warp::thin_plate_toward(&frame.features, side, frame.t, &frame.warp, warm.as_deref())
-        .map_err(|e| Failure::BadInput(e.to_string()))?;
+    let w = make_warp::thin_plate_toward(
+        &inputs.features,
+        side,
+        inputs.t,
+        &inputs.warp,
+        warm.as_deref(),
+    )
+    .map_err(|e| Failure::BadInput(e.to_string()))?;
     if crate::wrapper::host::switches().verbose {
         let cycles = |r: &Report| r.residuals.len() - 1;
         eprintln!(

@@ -9,7 +9,7 @@ use morphfx::geom::{PixelScale, Vec2};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 use openfx::sys::generic::core::*;
 
-use super::params::{slot_ids, Settings, LINE_COUNT, LINE_SLOTS, SNAP_LINES, SNAP_SIGMA};
+use super::params::{slot_ids, Reader, Settings, LINE_COUNT, SNAP_LINES, SNAP_SIGMA};
 use super::render::context;
 use super::{instance, NodeKind};
 use crate::wrapper::clips::{Depth, Effect};
@@ -25,10 +25,8 @@ pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> O
     let instance = instance::get(effect)?;
     let params = instance.params()?;
     let settings = Settings::read(params, time, kind);
-    let sigma = params
-        .double(SNAP_SIGMA, time)
-        .unwrap_or(3.0)
-        .clamp(0.5, 50.0);
+    let r = Reader::new(params, kind, time);
+    let sigma = r.double(SNAP_SIGMA);
     let (a, b) = kind.source_clips(&context(effect));
     let energy_a = edge_energy(effect, a, time + settings.offset_a as f64, sigma)?;
     let energy_b = match b {
@@ -40,12 +38,12 @@ pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> O
         )?),
         None => None,
     };
-    let count = params.int(LINE_COUNT, time)?.clamp(0, LINE_SLOTS as i32) as usize;
+    let count = r.int(LINE_COUNT) as usize;
     // Every endpoint's new key first, then all written as one undo step.
     let mut keys = Vec::new();
     for k in 1..=count {
         let [enable, a0, a1, b0, b1] = slot_ids(k);
-        if params.int(&enable, time)? == 0 {
+        if !r.bool(&enable) {
             continue;
         }
         let sides =

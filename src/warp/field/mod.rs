@@ -8,9 +8,11 @@ pub mod weight;
 
 pub use lines::{interpolate_line, line_pairs_toward, LinePair};
 
+use crate::choice::Choice;
 use crate::features::{Feature, Side, Tween};
 use crate::geom::{PixelScale, RectI, Vec2};
-use crate::warp::{Warp, WarpMap};
+use crate::image::WarpMap;
+use crate::warp::Warp;
 use weight::Weight;
 
 /// How lines move from their A to their B position over `t` (Beier-Neely §3.4).
@@ -23,18 +25,12 @@ pub enum LineInterpolation {
     CenterAngle,
 }
 
-impl LineInterpolation {
-    pub fn name(self) -> &'static str {
+impl Choice for LineInterpolation {
+    const ALL: &'static [Self] = &[LineInterpolation::Endpoints, LineInterpolation::CenterAngle];
+    fn name(self) -> &'static str {
         match self {
             LineInterpolation::Endpoints => "endpoints",
             LineInterpolation::CenterAngle => "center-angle",
-        }
-    }
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "endpoints" => Some(LineInterpolation::Endpoints),
-            "center-angle" => Some(LineInterpolation::CenterAngle),
-            _ => None,
         }
     }
 }

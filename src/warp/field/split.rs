@@ -15,7 +15,7 @@ use wide::f32x8;
 use super::kernel::{Lines, Sums};
 use super::FieldWarp;
 use crate::geom::{PixelScale, RectI, Vec2};
-use crate::warp::WarpMap;
+use crate::image::WarpMap;
 
 /// Side of a block, pixels.
 const BLOCK: i32 = 48;

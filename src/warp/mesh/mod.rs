@@ -18,6 +18,7 @@ mod two_pass;
 pub use patch::MeshWarp;
 pub use two_pass::{two_pass, two_pass_into};
 
+use crate::choice::Choice;
 use crate::error::{Error, Result};
 use crate::features::{Side, Tween};
 use crate::geom::Vec2;
@@ -176,17 +177,13 @@ pub enum Pass {
     OnePass,
 }
 
-impl Pass {
-    pub fn name(self) -> &'static str {
+impl Choice for Pass {
+    const ALL: &'static [Self] = &[Pass::TwoPass, Pass::OnePass];
+    fn name(self) -> &'static str {
         match self {
             Pass::TwoPass => "two-pass",
             Pass::OnePass => "one-pass",
         }
-    }
-    pub fn parse(s: &str) -> Option<Self> {
-        [Pass::TwoPass, Pass::OnePass]
-            .into_iter()
-            .find(|p| p.name() == s)
     }
 }
 

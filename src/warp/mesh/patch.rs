@@ -10,7 +10,8 @@ use rayon::prelude::*;
 use super::{Mesh, MeshPair};
 use crate::features::{Side, Tween};
 use crate::geom::{PixelScale, RectI, Vec2};
-use crate::warp::{Warp, WarpMap};
+use crate::image::WarpMap;
+use crate::warp::Warp;
 
 /// Catmull-Rom basis in powers of the local parameter (times 2).
 const M: [[f64; 4]; 4] = [

@@ -9,8 +9,9 @@ mod pinning;
 pub mod plate;
 
 use super::node_grid::NodeGrid;
-use super::{Warp, WarpMap};
+use super::Warp;
 use crate::geom::{PixelScale, RectD, RectI, Vec2};
+use crate::image::WarpMap;
 use multigrid::{Hierarchy, Report};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
