@@ -3,8 +3,7 @@
 //! the same frame (the second thread waits for the first instead of computing
 //! again), bounded in memory.
 
-use std::collections::hash_map::DefaultHasher;
-use std::hash::{Hash, Hasher};
+use std::fmt::Debug;
 use std::sync::{Arc, Mutex};
 
 use morphfx::image::WarpMap;
@@ -39,7 +38,7 @@ impl Weigh for Correspondence {
 type Slot<T> = Arc<Mutex<Option<Arc<T>>>>;
 
 struct Entry<T> {
-    key: u64,
+    key: Key,
     slot: Slot<T>,
     bytes: usize,
     last_use: u64,
@@ -58,12 +57,18 @@ impl<T: Weigh> Default for Cache<T> {
     }
 }
 
-/// A cache key from anything whose `Debug` form names all it depends on
-/// (floats print exactly, so equal text means equal inputs).
-pub fn key_of(parts: &impl std::fmt::Debug) -> u64 {
-    let mut h = DefaultHasher::new();
-    format!("{parts:?}").hash(&mut h);
-    h.finish()
+/// A cache key: the `Debug` text of everything a value depends on, kept
+/// whole and compared in full on every lookup (never a hash, which two
+/// inputs could share). Rust prints a float as the shortest decimal that
+/// reads back to the same bits, so equal keys mean bit-equal inputs (NaNs
+/// aside: features and settings that reach a cache are finite).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Key(Arc<str>);
+
+impl Key {
+    pub fn of(parts: &impl Debug) -> Key {
+        Key(format!("{parts:?}").into())
+    }
 }
 
 impl<T: Weigh> Cache<T> {
@@ -76,7 +81,7 @@ impl<T: Weigh> Cache<T> {
 
     pub fn get_or_compute<E>(
         &self,
-        key: u64,
+        key: Key,
         compute: impl FnOnce() -> Result<T, E>,
     ) -> Result<Arc<T>, E> {
         let slot = {
@@ -91,7 +96,7 @@ impl<T: Weigh> Cache<T> {
                 None => {
                     let slot: Slot<T> = Arc::new(Mutex::new(None));
                     entries.push(Entry {
-                        key,
+                        key: key.clone(),
                         slot: slot.clone(),
                         bytes: 0,
                         last_use: *clock,
@@ -108,14 +113,14 @@ impl<T: Weigh> Cache<T> {
         let map = Arc::new(compute()?);
         *value = Some(map.clone());
         drop(value);
-        self.account(key, map.bytes());
+        self.account(&key, map.bytes());
         Ok(map)
     }
 
-    fn account(&self, key: u64, bytes: usize) {
+    fn account(&self, key: &Key, bytes: usize) {
         let mut guard = self.entries.lock().unwrap_or_else(|e| e.into_inner());
         let (entries, _) = &mut *guard;
-        if let Some(e) = entries.iter_mut().find(|e| e.key == key) {
+        if let Some(e) = entries.iter_mut().find(|e| e.key == *key) {
             e.bytes = bytes;
         }
         // Evict least recently used entries (never the one just made) over budget.
@@ -123,7 +128,7 @@ impl<T: Weigh> Cache<T> {
             let Some((i, _)) = entries
                 .iter()
                 .enumerate()
-                .filter(|(_, e)| e.key != key)
+                .filter(|(_, e)| e.key != *key)
                 .min_by_key(|(_, e)| e.last_use)
             else {
                 break;
@@ -173,7 +178,7 @@ mod tests {
             for _ in 0..8 {
                 s.spawn(|| {
                     cache
-                        .get_or_compute::<()>(42, || {
+                        .get_or_compute::<()>(Key::of(&42), || {
                             calls.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
                             std::thread::sleep(std::time::Duration::from_millis(20));
                             Ok(map(4))
@@ -185,11 +190,31 @@ mod tests {
         assert_eq!(calls.load(std::sync::atomic::Ordering::SeqCst), 1);
     }
 
+    /// Keys differ wherever their inputs' bits do, however close the values.
+    #[test]
+    fn keys_tell_apart_inputs_one_bit_apart() {
+        let x = 0.1f64;
+        let next = f64::from_bits(x.to_bits() + 1);
+        assert_ne!(Key::of(&(x, 1)), Key::of(&(next, 1)));
+        assert_ne!(Key::of(&0.0f64), Key::of(&-0.0f64));
+        assert_eq!(Key::of(&(x, "a")), Key::of(&(0.1f64, "a")));
+        let cache = WarpCache::default();
+        let a = cache
+            .get_or_compute::<()>(Key::of(&x), || Ok(map(1)))
+            .unwrap();
+        let b = cache
+            .get_or_compute::<()>(Key::of(&next), || Ok(map(2)))
+            .unwrap();
+        assert_eq!((a.window.width(), b.window.width()), (1, 2));
+    }
+
     #[test]
     fn stays_within_its_budget() {
         let cache = WarpCache::new(100 * 8);
         for k in 0..10 {
-            cache.get_or_compute::<()>(k, || Ok(map(40))).unwrap();
+            cache
+                .get_or_compute::<()>(Key::of(&k), || Ok(map(40)))
+                .unwrap();
         }
         assert!(cache.bytes() <= 100 * 8);
     }

@@ -13,7 +13,7 @@ use morphfx::warp::thin_plate::ThinPlate;
 use super::params::table_in_context;
 use super::render::context;
 use super::NodeKind;
-use crate::cache::{Cache, WarpCache};
+use crate::cache::{Cache, Key, WarpCache};
 use crate::wrapper::clips::Effect;
 use crate::wrapper::params::Params;
 use crate::wrapper::{dispatch, Failure, Outcome};
@@ -37,10 +37,10 @@ pub struct Instance {
     pub correspondences: Cache<Correspondence>,
     /// The last solved `auto` grids by frame, for warm starts: `(time,
     /// settings key, grid)`, at most [`GRIDS_KEPT`].
-    pub grids: Mutex<Vec<(f64, u64, Grid)>>,
+    pub grids: Mutex<Vec<(f64, Key, Grid)>>,
     /// The last solved thin plates, for warm starts: `(time, settings and
     /// side key, plates)`, at most [`PLATES_KEPT`].
-    pub plates: Mutex<Vec<(f64, u64, Arc<ThinPlate>)>>,
+    pub plates: Mutex<Vec<(f64, Key, Arc<ThinPlate>)>>,
     /// Per-pixel dissolve weights of non-uniform colour transitions, keyed
     /// like the warps they come from.
     pub weights: Cache<Weights>,

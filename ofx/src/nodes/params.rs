@@ -375,7 +375,8 @@ pub struct Settings {
 /// default it declares stands in for a value the host cannot give, and its
 /// range bounds the value.
 pub struct Reader<'a> {
-    params: &'a Params,
+    /// `None`: every param at its default.
+    params: Option<&'a Params>,
     table: &'a [ParamSpec],
     time: f64,
     missing: RefCell<Vec<String>>,
@@ -384,7 +385,7 @@ pub struct Reader<'a> {
 impl<'a> Reader<'a> {
     pub fn new(params: &'a Params, kind: NodeKind, time: f64) -> Self {
         Reader {
-            params,
+            params: Some(params),
             table: table(kind),
             time,
             missing: RefCell::new(Vec::new()),
@@ -400,7 +401,7 @@ impl<'a> Reader<'a> {
 
     /// The host's value, or `None` (and `id` noted missing).
     fn host<T>(&self, id: &str, read: impl FnOnce(&Params) -> Outcome<T>) -> Option<T> {
-        let value = read(self.params).ok();
+        let value = read(self.params?).ok();
         if value.is_none() {
             self.missing.borrow_mut().push(id.to_owned());
         }
@@ -474,7 +475,22 @@ impl<'a> Reader<'a> {
 
 impl Settings {
     pub fn read(params: &Params, time: f64, kind: NodeKind) -> Settings {
-        let r = Reader::new(params, kind, time);
+        Settings::read_with(Reader::new(params, kind, time), kind)
+    }
+
+    /// Every param at the default its table entry declares.
+    #[cfg(test)]
+    pub fn defaults(kind: NodeKind) -> Settings {
+        let reader = Reader {
+            params: None,
+            table: table(kind),
+            time: 0.0,
+            missing: RefCell::new(Vec::new()),
+        };
+        Settings::read_with(reader, kind)
+    }
+
+    fn read_with(r: Reader<'_>, kind: NodeKind) -> Settings {
         let warp = MethodSettings {
             method: r.pick(METHOD, methods(kind)),
             field: field_settings(&r),
@@ -733,6 +749,19 @@ mod tests {
             options(NodeKind::Morph, EDGE).expect("edge").0,
             EdgeMode::names()
         );
+    }
+
+    /// The defaults a fresh node renders with: what the table declares.
+    #[test]
+    fn defaults_are_the_tables() {
+        let s = Settings::defaults(NodeKind::Morph);
+        assert_eq!(s.warp.method, Method::Field);
+        assert_eq!(s.progress, 0.5);
+        assert_eq!(s.view, View::Morph);
+        assert_eq!(s.edge, EdgeMode::Clamp);
+        assert!(s.lines.is_empty() && s.missing.is_empty());
+        assert_eq!(s.warp.field, FieldSettings::default());
+        assert_eq!(Settings::defaults(NodeKind::Warp).view, View::WarpedA);
     }
 
     #[test]

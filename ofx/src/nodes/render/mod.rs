@@ -1,0 +1,544 @@
+//! Render glue, in three stages: [`gather`] reads everything from the host
+//! (params, clips, images), [`prepare`] computes what the pixels depend on
+//! (pure given the instance's caches), [`draw`] writes the output rows at
+//! the host's depths. Conversions to pixel rows, render scale and pixel
+//! aspect happen here, once (DESIGN rule 3).
+
+mod draw;
+mod inputs;
+mod regions;
+mod warm;
+
+use std::sync::Arc;
+
+use morphfx::features::Side;
+use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
+use morphfx::image::{EdgeMode, ImageView, Layout, Sampler, WarpMap};
+use morphfx::make_warp::{self, Method};
+use morphfx::transition;
+use morphfx::views::View;
+use morphfx::warp::auto::WorkImage;
+use morphfx::warp::mesh::Pass;
+use morphfx::warp::Warp;
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::message::*;
+
+use super::instance::{self, Instance};
+use super::params::Settings;
+use super::NodeKind;
+use crate::cache::Key;
+use crate::wrapper::clips::{Depth, Effect, HostImage, HostSample, ImageInfo};
+use crate::wrapper::props::PropSet;
+use crate::wrapper::{Failure, Outcome};
+use draw::Job;
+use inputs::{warp_inputs, WarpInputs};
+pub use regions::{
+    clip_preferences, frames_needed, is_identity, region_of_definition, regions_of_interest,
+};
+
+/// `$body` with `$T` the Rust type of a host bit depth.
+macro_rules! with_depth {
+    ($depth:expr, $T:ident => $body:expr) => {
+        match $depth {
+            Depth::U8 => {
+                type $T = u8;
+                $body
+            }
+            Depth::U16 => {
+                type $T = u16;
+                $body
+            }
+            Depth::F32 => {
+                type $T = f32;
+                $body
+            }
+        }
+    };
+}
+
+pub(super) const TRANSITION: &str = "OfxImageEffectContextTransition";
+
+pub(super) fn context(effect: &Effect) -> String {
+    effect
+        .props()
+        .and_then(|p| p.get_string(kOfxImageEffectPropContext, 0))
+        .unwrap_or_default()
+}
+
+/// The render action: gather, prepare, draw.
+pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
+    let instance = instance::get(effect)?;
+    let (mut request, mut lent) = gather(kind, effect, &instance, in_args)?;
+    if effect.aborted() {
+        return Ok(());
+    }
+    correspond(&instance, &mut request)?;
+    let job = prepare(kind, &instance, &request)?;
+    if effect.aborted() {
+        return Ok(());
+    }
+    draw(kind, &job, &request, &mut lent)
+}
+
+/// A source as [`prepare`] sees it: what its image's properties say.
+#[derive(Debug, Clone, Copy)]
+struct Source {
+    scale: PixelScale,
+    /// The canonical rectangle its pixels cover.
+    covers: RectD,
+    premultiplied: bool,
+}
+
+/// What one render reads from the host, holding no host handle: everything
+/// [`prepare`] needs, so it can be made by hand in tests.
+struct Request {
+    time: f64,
+    window: RectI,
+    /// The host renders frames in order on this instance (warm starts allowed).
+    sequential: bool,
+    settings: Settings,
+    inputs: WarpInputs,
+    /// Sources A and B (`None`: no image).
+    sources: [Option<Source>; 2],
+    /// The sample depth both sources are read at.
+    depth: Depth,
+    out_scale: PixelScale,
+    /// The rectangle ST maps are normalised by, as (origin, size).
+    project: (Vec2, Vec2),
+    /// Both sources as `auto` work images (method `auto` only).
+    work: Option<[WorkImage; 2]>,
+}
+
+/// The host's images one render holds: sources A and B, and the output.
+struct Lent {
+    sources: [Option<HostImage>; 2],
+    out: HostImage,
+}
+
+/// A source clip's image, or `None` where the host has none: an unconnected
+/// clip, or a fetch that failed, which the spec says to treat as transparent
+/// black and carry on.
+fn source(effect: &Effect, name: &str, time: f64) -> Outcome<Option<HostImage>> {
+    let clip = effect.clip(name)?;
+    if !clip.is_connected() {
+        return Ok(None);
+    }
+    clip.image(time)
+}
+
+fn scale_of(i: &ImageInfo) -> PixelScale {
+    PixelScale::new(i.render_scale.0, i.render_scale.1, i.par)
+}
+
+/// Everything one render reads from the host, and the images it holds.
+fn gather(
+    kind: NodeKind,
+    effect: &Effect,
+    instance: &Instance,
+    in_args: &PropSet,
+) -> Outcome<(Request, Lent)> {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
+    let sequential = in_args
+        .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
+        .unwrap_or(0)
+        == 1;
+    let context = context(effect);
+    let settings = read_settings(kind, effect, instance, time)?;
+    let mut inputs = warp_inputs(kind, instance, &settings, time, &context)?;
+    let (a_name, b_name) = kind.source_clips(&context);
+    let a = source(effect, a_name, time + settings.offset_a as f64)?;
+    let b = match b_name {
+        Some(b) => source(effect, b, time + settings.offset_b as f64)?,
+        None => None,
+    };
+    let out = effect
+        .clip("Output")?
+        .image(time)?
+        .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
+    let rod = regions::output_region(kind, effect, &context, time)?;
+    // Triangles pin the border of the frame, so the whole frame warps.
+    inputs.warp.region = Some(regions::warp_region(effect, &rod));
+    let out_scale = scale_of(out.info());
+    let depth = source_depth(&a, &b, out.info().depth)?;
+    let sources = [&a, &b].map(|s| {
+        s.as_ref().map(|image| {
+            let i = image.info();
+            Source {
+                scale: scale_of(i),
+                covers: canonical(i.bounds, scale_of(i)),
+                premultiplied: i.premultiplied,
+            }
+        })
+    });
+    let work = match inputs.warp.method() {
+        Method::Auto => Some(work_images(&a, &b, depth)?),
+        _ => None,
+    };
+    let request = Request {
+        time,
+        window: RectI::new(x1, y1, x2, y2),
+        sequential,
+        settings,
+        inputs,
+        sources,
+        depth,
+        out_scale,
+        project: regions::project(effect, &rod),
+        work,
+    };
+    let lent = Lent {
+        sources: [a, b],
+        out,
+    };
+    Ok((request, lent))
+}
+
+/// The params at `time`; params the host could not read are said once.
+fn read_settings(
+    kind: NodeKind,
+    effect: &Effect,
+    instance: &Instance,
+    time: f64,
+) -> Outcome<Settings> {
+    let settings = Settings::read(instance.params()?, time, kind);
+    if !settings.missing.is_empty() && instance.first_time("missing params") {
+        effect.message(
+            kOfxMessageWarning,
+            c"net.morphfx.MissingParams",
+            &format!(
+                "the host could not read these params; their defaults are used: {}",
+                settings.missing.join(", ")
+            ),
+        );
+    }
+    Ok(settings)
+}
+
+/// Both sources are read at one depth (the descriptor says so); a missing
+/// one takes the other's, or the output's.
+fn source_depth(a: &Option<HostImage>, b: &Option<HostImage>, out: Depth) -> Outcome<Depth> {
+    match (
+        a.as_ref().map(HostImage::info),
+        b.as_ref().map(HostImage::info),
+    ) {
+        (Some(a), Some(b)) if a.depth != b.depth => Err(Failure::BadInput(
+            "Source A and Source B have different bit depths".into(),
+        )),
+        (Some(i), _) | (None, Some(i)) => Ok(i.depth),
+        (None, None) => Ok(out),
+    }
+}
+
+/// Both sources' pixels as `auto` work images.
+fn work_images(
+    a: &Option<HostImage>,
+    b: &Option<HostImage>,
+    depth: Depth,
+) -> Outcome<[WorkImage; 2]> {
+    let (Some(a), Some(b)) = (a, b) else {
+        return Err(Failure::BadInput(
+            "method \"auto\" finds its warp from two images: connect both sources (Morph node)"
+                .into(),
+        ));
+    };
+    Ok(with_depth!(depth, S => [
+        WorkImage::from_view(&a.view::<S>()?),
+        WorkImage::from_view(&b.view::<S>()?),
+    ]))
+}
+
+/// The canonical rectangle a host image's pixels cover.
+fn canonical(bounds: RectI, scale: PixelScale) -> RectD {
+    RectD::new(
+        bounds.x1 as f64 / scale.x,
+        bounds.y1 as f64 / scale.y,
+        bounds.x2 as f64 / scale.x,
+        bounds.y2 as f64 / scale.y,
+    )
+}
+
+/// Method `auto`: the correspondence of the two work images, which the
+/// maps are then made from like any method's.
+fn correspond(instance: &Instance, request: &mut Request) -> Outcome {
+    if let Some([a, b]) = &request.work {
+        let covers = |k: usize| request.sources[k].map_or(RectD::default(), |s| s.covers);
+        let c = warm::correspondence(
+            instance,
+            &request.inputs,
+            (request.time, request.sequential),
+            (a, covers(0)),
+            (b, covers(1)),
+        )?;
+        request.inputs.warp.correspondence = Some(c);
+    }
+    Ok(())
+}
+
+/// Everything the pixels depend on, computed (or found in the caches) from
+/// what [`gather`] read: the maps for the render window, the dissolve
+/// weights, the transition rates. Pure given the instance's caches: no
+/// host call.
+fn prepare<'r>(kind: NodeKind, instance: &'r Instance, request: &'r Request) -> Outcome<Job<'r>> {
+    let inputs = &request.inputs;
+    let view = request.settings.view;
+    // The two-pass mesh warp makes pixels (per render window), not a map:
+    // pictures take that path, ST maps and the grid the one-pass map.
+    let mesh = inputs.warp.method() == Method::Mesh;
+    if mesh {
+        inputs.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
+    }
+    let two_pass = mesh && inputs.warp.settings.mesh.pass == Pass::TwoPass;
+    let picture = matches!(view, View::Morph | View::WarpedA | View::WarpedB);
+    // A non-uniform colour transition weighs every pixel of the dissolve.
+    let weighted = view == View::Morph
+        && kind == NodeKind::Morph
+        && !inputs
+            .warp
+            .settings
+            .transition
+            .colour()
+            .is_uniform_at(inputs.t);
+    // The two-pass mesh warp makes pixels, not maps; weights need maps.
+    let by_map = !(two_pass && picture) || weighted;
+    let map = |side| map(instance, request, side);
+    let rates = match view {
+        View::Transition => Some(
+            inputs
+                .warp
+                .geometry_rates(&inputs.features, inputs.t)
+                .map_err(bad_input)?,
+        ),
+        _ => None,
+    };
+    let (origin, size) = request.project;
+    Ok(Job {
+        view,
+        weights: match weighted {
+            true => Some(weights(instance, request, map(Side::A)?, map(Side::B)?)?),
+            false => None,
+        },
+        rates,
+        t: inputs.t,
+        features: &inputs.features,
+        map_a: (needs_a(view) && by_map)
+            .then(|| map(Side::A))
+            .transpose()?,
+        map_b: (needs_b(kind, view) && by_map)
+            .then(|| map(Side::B))
+            .transpose()?,
+        meshes: if by_map {
+            None
+        } else {
+            inputs.warp.meshes.as_ref()
+        },
+        planes: &instance.planes,
+        premultiply: premultiply(&request.sources),
+        scale: request.out_scale,
+        origin,
+        size,
+    })
+}
+
+fn bad_input(e: morphfx::Error) -> Failure {
+    Failure::BadInput(e.to_string())
+}
+
+/// The map of `side`'s warp over the render window, from the cache or made.
+/// Maps cover the render window, never more: a tile costs its own pixels,
+/// and an infinite region of definition costs nothing extra.
+fn map(instance: &Instance, request: &Request, side: Side) -> Outcome<Arc<WarpMap>> {
+    let (inputs, window, scale) = (&request.inputs, request.window, request.out_scale);
+    let key = Key::of(&(inputs, side, window, scale));
+    instance.warps.get_or_compute(key, || {
+        let w: Arc<dyn Warp> = if inputs.warp.method() == Method::ThinPlate {
+            let when = (request.time, request.sequential);
+            Arc::new(warm::thin_plate(instance, inputs, side, when)?)
+        } else {
+            make_warp::toward(&inputs.features, side, inputs.t, &inputs.warp)?
+        };
+        Ok::<_, Failure>(w.map_window(window, scale))
+    })
+}
+
+/// The per-pixel dissolve weights of a non-uniform colour transition.
+fn weights(
+    instance: &Instance,
+    request: &Request,
+    ma: Arc<WarpMap>,
+    mb: Arc<WarpMap>,
+) -> Outcome<Arc<transition::Weights>> {
+    let inputs = &request.inputs;
+    let key = Key::of(&(inputs, "weights", request.window, request.out_scale));
+    instance.weights.get_or_compute(key, || {
+        let colour = inputs
+            .warp
+            .colour_rates(&inputs.features, inputs.t)
+            .map_err(bad_input)?;
+        // W1 carries B onto A: the warp of A toward B's positions.
+        let w1 =
+            make_warp::toward(&inputs.features, Side::A, 1.0, &inputs.warp).map_err(bad_input)?;
+        Ok::<_, Failure>(transition::colour_weights(&colour, &ma, &mb, w1.as_ref()))
+    })
+}
+
+/// Which sources (A, B) are straight but must come out premultiplied: the
+/// output is premultiplied unless every source with an image is straight
+/// (see [`clip_preferences`]), and a dissolve adds like to like.
+fn premultiply(sources: &[Option<Source>; 2]) -> [bool; 2] {
+    let [a, b] = sources.map(|s| s.map(|s| !s.premultiplied));
+    let output_straight = a.unwrap_or(true) && b.unwrap_or(true) && (a.is_some() || b.is_some());
+    [
+        !output_straight && a == Some(true),
+        !output_straight && b == Some(true),
+    ]
+}
+
+fn needs_a(view: View) -> bool {
+    matches!(
+        view,
+        View::Morph | View::WarpedA | View::StmapA | View::Grid | View::Transition
+    )
+}
+
+fn needs_b(kind: NodeKind, view: View) -> bool {
+    kind == NodeKind::Morph && matches!(view, View::Morph | View::WarpedB | View::StmapB)
+}
+
+/// A view over `source`'s pixels, or over one transparent black pixel.
+fn view_of<'a, S: HostSample>(
+    source: &'a Option<HostImage>,
+    black: &'a [S; 4],
+) -> Outcome<ImageView<'a, S>> {
+    match source {
+        Some(image) => image.view::<S>(),
+        None => {
+            ImageView::new(black, Layout::packed(RectI::new(0, 0, 1, 1), 4)).map_err(Failure::from)
+        }
+    }
+}
+
+/// Writes the render window of the output: samplers over the lent sources
+/// at their depth, rows of the output at its own.
+fn draw(kind: NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Outcome {
+    let settings = &request.settings;
+    let [a, b] = &lent.sources;
+    let sampler_parts = |k: usize, s: &Option<HostImage>| {
+        let source = request.sources[k];
+        (
+            source.map_or(request.out_scale, |s| s.scale),
+            // Transparent black outside a source with no image.
+            if s.is_some() {
+                settings.edge
+            } else {
+                EdgeMode::Black
+            },
+            source.is_none_or(|s| s.premultiplied),
+        )
+    };
+    let ((a_scale, a_edge, a_pre), (b_scale, b_edge, b_pre)) =
+        (sampler_parts(0, a), sampler_parts(1, b));
+    with_depth!(lent.out.info().depth, D => {
+        let rows = lent.out.rows_mut::<D>(request.window)?;
+        with_depth!(request.depth, S => {
+            let black = [S::default(); 4];
+            let a = Sampler::new(view_of::<S>(a, &black)?, a_scale, settings.filter, a_edge, a_pre);
+            if kind == NodeKind::Morph {
+                let b = Sampler::new(view_of::<S>(b, &black)?, b_scale, settings.filter, b_edge, b_pre);
+                job.draw(&a, Some(&b), rows);
+            } else {
+                job.draw(&a, None, rows);
+            }
+        })
+    });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use morphfx::features::Feature;
+    use morphfx::make_warp::WarpSettings;
+
+    fn source(premultiplied: bool) -> Option<Source> {
+        Some(Source {
+            scale: PixelScale::UNIT,
+            covers: RectD::new(0.0, 0.0, 64.0, 48.0),
+            premultiplied,
+        })
+    }
+
+    /// A render of a 64x48 frame's window (8, 8)-(24, 20), made by hand.
+    fn request(t: f64, view: View) -> Request {
+        let mut settings = Settings::defaults(NodeKind::Morph);
+        settings.view = view;
+        let features = vec![Feature::line(
+            [Vec2::new(10.0, 10.0), Vec2::new(50.0, 12.0)],
+            [Vec2::new(12.0, 16.0), Vec2::new(48.0, 30.0)],
+        )];
+        let warp = WarpSettings {
+            region: Some(RectD::new(0.0, 0.0, 64.0, 48.0)),
+            ..WarpSettings::new(settings.warp.clone())
+        };
+        Request {
+            time: 1.0,
+            window: RectI::new(8, 8, 24, 20),
+            sequential: false,
+            settings,
+            inputs: WarpInputs { features, warp, t },
+            sources: [source(true), source(true)],
+            depth: Depth::F32,
+            out_scale: PixelScale::UNIT,
+            project: (Vec2::new(0.0, 0.0), Vec2::new(64.0, 48.0)),
+            work: None,
+        }
+    }
+
+    /// Prepare makes each side's map exactly as the core does, over the
+    /// render window only, and a second render of the same request finds
+    /// them in the cache.
+    #[test]
+    fn prepare_makes_the_cores_maps_for_the_window_once() {
+        let instance = Instance::default();
+        let r = request(0.25, View::Morph);
+        let job = prepare(NodeKind::Morph, &instance, &r).expect("prepared");
+        for (side, got) in [(Side::A, &job.map_a), (Side::B, &job.map_b)] {
+            let got = got.as_ref().expect("a map per side");
+            let want = make_warp::toward(&r.inputs.features, side, 0.25, &r.inputs.warp)
+                .expect("warp")
+                .map_window(r.window, PixelScale::UNIT);
+            assert_eq!(**got, want, "{side:?}");
+        }
+        let again = prepare(NodeKind::Morph, &instance, &r).expect("prepared");
+        assert!(Arc::ptr_eq(
+            job.map_a.as_ref().unwrap(),
+            again.map_a.as_ref().unwrap()
+        ));
+        let later = request(0.75, View::Morph);
+        let moved = prepare(NodeKind::Morph, &instance, &later).expect("prepared");
+        assert_ne!(job.map_a, moved.map_a, "another progress, another map");
+    }
+
+    /// Views take only the maps they draw: the Warp node never makes B's.
+    #[test]
+    fn prepare_makes_only_the_maps_a_view_draws() {
+        let instance = Instance::default();
+        let r = request(0.5, View::StmapB);
+        let stmap_b = prepare(NodeKind::Morph, &instance, &r).unwrap();
+        assert!(stmap_b.map_a.is_none() && stmap_b.map_b.is_some());
+        let r = request(0.5, View::WarpedA);
+        let warp = prepare(NodeKind::Warp, &instance, &r).unwrap();
+        assert!(warp.map_a.is_some() && warp.map_b.is_none());
+    }
+
+    /// A straight source dissolved with a premultiplied one is brought to
+    /// premultiplied colour; all-straight sources stay straight.
+    #[test]
+    fn straight_sources_are_premultiplied_only_beside_premultiplied_ones() {
+        assert_eq!(premultiply(&[source(false), source(true)]), [true, false]);
+        assert_eq!(premultiply(&[source(false), source(false)]), [false, false]);
+        assert_eq!(premultiply(&[source(false), None]), [false, false]);
+        assert_eq!(premultiply(&[None, None]), [false, false]);
+    }
+}

@@ -1,0 +1,137 @@
+//! Solves that start from this instance's earlier ones: `auto`
+//! correspondences and thin plates, warm-started only in sequential renders.
+
+use std::sync::Arc;
+
+use morphfx::features::Side;
+use morphfx::geom::RectD;
+use morphfx::make_warp;
+use morphfx::warp::auto::{self, Correspondence, WorkImage};
+use morphfx::warp::thin_plate::multigrid::Report;
+use morphfx::warp::thin_plate::ThinPlateWarp;
+
+use super::inputs::WarpInputs;
+use crate::cache::Key;
+use crate::nodes::instance::{Instance, GRIDS_KEPT, PLATES_KEPT};
+use crate::wrapper::{Failure, Outcome};
+
+/// The frame's `auto` correspondence: solved once per content of the two
+/// images and settings (tiles and repeated renders share it), warm-started
+/// from the previous frame's grid when this instance solved it.
+pub(super) fn correspondence(
+    instance: &Instance,
+    inputs: &WarpInputs,
+    (time, sequential): (f64, bool),
+    (a, a_frame): (&WorkImage, RectD),
+    (b, b_frame): (&WorkImage, RectD),
+) -> Outcome<Arc<Correspondence>> {
+    let settings = &inputs.warp.settings.auto;
+    let per_segment = inputs.warp.settings.samples_per_segment;
+    let same_setup = Key::of(&(
+        settings,
+        per_segment,
+        a_frame,
+        b_frame,
+        a.width,
+        a.height,
+        b.width,
+        b.height,
+    ));
+    let key = Key::of(&(&same_setup, a.digest(), b.digest(), &inputs.features));
+    instance.correspondences.get_or_compute(key, || {
+        // Warm starts only in a sequential render: otherwise the result
+        // would depend on which frames this instance happened to render.
+        let warm = sequential
+            .then(|| {
+                let grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+                grids
+                    .iter()
+                    .find(|(t, k, _)| *t == time - 1.0 && *k == same_setup)
+                    .map(|(_, _, g)| g.clone())
+            })
+            .flatten();
+        let started = std::time::Instant::now();
+        let (c, table) = auto::correspond(
+            a,
+            a_frame,
+            b,
+            b_frame,
+            &inputs.features,
+            per_segment,
+            settings,
+            warm.as_ref(),
+        )
+        .map_err(|e| Failure::BadInput(e.to_string()))?;
+        if crate::wrapper::host::switches().verbose {
+            eprintln!(
+                "auto: frame {time}: {}x{} to {}x{}, {} start, {:.2} s\n{}",
+                a.width,
+                a.height,
+                b.width,
+                b.height,
+                if warm.is_some() && settings.warm_start {
+                    "warm"
+                } else {
+                    "cold"
+                },
+                started.elapsed().as_secs_f64(),
+                auto::table_text(&table)
+            );
+        }
+        let mut grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+        grids.retain(|(t, k, _)| !(*t == time && *k == same_setup));
+        if grids.len() >= GRIDS_KEPT {
+            grids.remove(0);
+        }
+        grids.push((time, same_setup, c.grid.clone()));
+        Ok(c)
+    })
+}
+
+/// The frame's thin plates on `side`, solved from the plates this instance
+/// solved nearest in time (this frame at another scale, or a neighbouring
+/// frame of the sequence) with the same settings: Lee et al.'s warm start,
+/// since features move little from frame to frame.
+pub(super) fn thin_plate(
+    instance: &Instance,
+    inputs: &WarpInputs,
+    side: Side,
+    (time, sequential): (f64, bool),
+) -> Outcome<ThinPlateWarp> {
+    let setup = Key::of(&(side, &inputs.warp.settings.thin_plate, inputs.warp.region));
+    // Warm starts only in a sequential render (see `correspondence`).
+    let warm = sequential
+        .then(|| {
+            let plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+            plates
+                .iter()
+                .filter(|(t, k, _)| *k == setup && (t - time).abs() <= 1.0)
+                .min_by(|a, b| (a.0 - time).abs().total_cmp(&(b.0 - time).abs()))
+                .map(|(_, _, p)| p.clone())
+        })
+        .flatten();
+    let w = make_warp::thin_plate_toward(
+        &inputs.features,
+        side,
+        inputs.t,
+        &inputs.warp,
+        warm.as_deref(),
+    )
+    .map_err(|e| Failure::BadInput(e.to_string()))?;
+    if crate::wrapper::host::switches().verbose {
+        let cycles = |r: &Report| r.residuals.len() - 1;
+        eprintln!(
+            "thin-plate: frame {time} side {side:?}: {} start, {} + {} cycles",
+            if warm.is_some() { "warm" } else { "cold" },
+            cycles(&w.plate.report_x),
+            cycles(&w.plate.report_y),
+        );
+    }
+    let mut plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+    plates.retain(|(t, k, _)| !(*t == time && *k == setup));
+    if plates.len() >= PLATES_KEPT {
+        plates.remove(0);
+    }
+    plates.push((time, setup, Arc::new(w.plate.clone())));
+    Ok(w)
+}
