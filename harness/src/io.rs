@@ -58,10 +58,19 @@ pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
     }
 }
 
-/// The pixel bounds and display window of an image file, from its header
-/// only (for checking a whole sequence before rendering without reading it
-/// twice).
-pub fn probe(path: &Path) -> std::result::Result<(RectI, DisplayWindow), HostError> {
+/// What an image file's header says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Header {
+    /// The pixel bounds (the data window, canonical).
+    pub bounds: RectI,
+    pub window: DisplayWindow,
+    /// Every channel is half float (an EXR written at half precision).
+    pub half: bool,
+}
+
+/// An image file's header only (for checking a whole sequence before
+/// rendering without reading it twice).
+pub fn probe(path: &Path) -> std::result::Result<Header, HostError> {
     if !path.exists() {
         return Err(HostError::bad(format!("{}: no such file", path.display())));
     }
@@ -77,7 +86,11 @@ pub fn probe(path: &Path) -> std::result::Result<(RectI, DisplayWindow), HostErr
             size: (w, h),
             origin: (0, 0),
         };
-        return Ok((RectI::from_size(w, h), window));
+        return Ok(Header {
+            bounds: RectI::from_size(w, h),
+            window,
+            half: false,
+        });
     }
     let meta = exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| HostError::bad(format!("{}: cannot read EXR: {e}", path.display())))?;
@@ -92,7 +105,16 @@ pub fn probe(path: &Path) -> std::result::Result<(RectI, DisplayWindow), HostErr
         size: (display.size.width(), display.size.height()),
         origin: (display.position.x(), display.position.y()),
     };
-    Ok((data_bounds(display, pos, (w, h)), window))
+    let half = header
+        .channels
+        .list
+        .iter()
+        .all(|c| c.sample_type == exr::meta::attribute::SampleType::F16);
+    Ok(Header {
+        bounds: data_bounds(display, pos, (w, h)),
+        window,
+        half,
+    })
 }
 
 /// An EXR data window in canonical pixels: EXR y grows downwards, canonical y

@@ -55,9 +55,12 @@ struct Common {
     /// Output file or #-padded sequence.
     #[arg(short = 'o', long = "output")]
     output: String,
-    /// Write half-float EXR instead of float.
-    #[arg(long)]
+    /// Write half-float EXR (default: the precision of the first input).
+    #[arg(long, conflicts_with = "float")]
     half: bool,
+    /// Write 32-bit float EXR (default: the precision of the first input).
+    #[arg(long)]
+    float: bool,
 }
 
 #[derive(Subcommand)]
@@ -451,14 +454,16 @@ impl Job {
         // The output keeps the first source's display window, frame by frame
         // (its size is every source's; its origin may move in a sequence).
         let mut first: Option<((usize, usize), String)> = None;
+        let mut half_in = false;
         let mut windows = std::collections::BTreeMap::new();
         for &f in &frames {
             for (k, (_, p)) in plates.iter().enumerate() {
                 let path = frame_path(&p.pattern, if is_sequence(&p.pattern) { f } else { 0 });
-                let (_, window) = io::probe(&path)?;
-                let s = window.size;
+                let header = io::probe(&path)?;
+                let (window, s) = (header.window, header.window.size);
                 if k == 0 {
                     windows.insert(f, window);
+                    half_in |= first.is_none() && header.half;
                 }
                 let name = path.display().to_string();
                 match &first {
@@ -500,7 +505,8 @@ impl Job {
         }
         // Hosts ask for clip preferences once the clips are connected.
         inst.clip_preferences()?;
-        let precision = if c.half {
+        // Half in, half out, unless the user says otherwise.
+        let precision = if c.half || (half_in && !c.float) {
             ExrPrecision::Half
         } else {
             ExrPrecision::Float
@@ -715,6 +721,7 @@ fn bench(
             frames: Some(format!("1-{frames}")),
             output: s(dir.join("morph.####.exr")),
             half: false,
+            float: true,
         },
     }
     .run(bundle_path)
@@ -816,6 +823,7 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
                     frames: Some("1-12".into()),
                     output: s(output),
                     half: false,
+                    float: true,
                 },
             }
             .run(bundle_path)

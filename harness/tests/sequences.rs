@@ -197,6 +197,58 @@ fn float_and_half_exr_round_trip_bit_exactly() {
     }
 }
 
+/// The contract's default: an output keeps its input's precision (half in,
+/// half out); `--half` and `--float` override. Read back from the written
+/// header by the exr crate, not by our own probe.
+#[test]
+fn outputs_keep_the_inputs_precision_unless_told() {
+    let d = tmp("precision");
+    let scene = d.join("s.morph.json");
+    std::fs::write(
+        &scene,
+        r#"{"format": "morphfx-scene", "version": 1,
+            "features": [{"type": "line", "a": [[5, 5], [30, 5]], "b": [[6, 5], [30, 7]]}]}"#,
+    )
+    .unwrap();
+    let written_half = |path: &Path| {
+        let meta = exr::meta::MetaData::read_from_file(path, false).unwrap();
+        let types: Vec<_> = meta.headers[0]
+            .channels
+            .list
+            .iter()
+            .map(|c| c.sample_type)
+            .collect();
+        assert!(types.windows(2).all(|w| w[0] == w[1]), "{types:?}");
+        types[0] == exr::meta::attribute::SampleType::F16
+    };
+    for (input, flag, want_half) in [
+        (ExrPrecision::Half, None, true),
+        (ExrPrecision::Float, None, false),
+        (ExrPrecision::Half, Some("--float"), false),
+        (ExrPrecision::Float, Some("--half"), true),
+    ] {
+        let src = d.join("src.exr");
+        write_plate(&src, 40, 24, 0.5, input);
+        let out = d.join("out.exr");
+        let mut args = vec![
+            "morph",
+            "--scene",
+            s(&scene),
+            "--a",
+            s(&src),
+            "--b",
+            s(&src),
+            "--t",
+            "0.5",
+            "-o",
+            s(&out),
+        ];
+        args.extend(flag);
+        morphfx(&args);
+        assert_eq!(written_half(&out), want_half, "{input:?} with {flag:?}");
+    }
+}
+
 /// OpenImageIO, an independent EXR reader, sees the pixels we think we wrote.
 #[test]
 fn openimageio_reads_our_outputs_as_we_do() {
