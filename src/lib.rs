@@ -1,12 +1,12 @@
 //! MorphFX core: everything a morph needs, with no knowledge of hosts or FFI.
 //!
-//! Data flows one way (see `DESIGN.md`):
+//! Data flows one way, and modules form layers (docs/architecture.md):
 //! scene → [`features`] at time → warp generator ([`warp`]) → warp field
 //! → resampling ([`image`]) → dissolve ([`morph`]).
 //!
 //! Coordinates are canonical pixel coordinates of the full-resolution image:
 //! x right, **y up**, origin at the bottom-left corner, pixel `(i, j)` centred
-//! at `(i + 0.5, j + 0.5)` (CONTRACT §1).
+//! at `(i + 0.5, j + 0.5)` (docs/coordinates.md).
 #![forbid(unsafe_code)]
 
 pub mod bspline;

@@ -9,7 +9,7 @@ use crate::image::WarpMap;
 use crate::image::{resample::fill, RowsMut, Sample};
 use crate::transition::Rates;
 
-/// The output view a node renders (CONTRACT §3 `--view`).
+/// The output view a node renders (the command line's `--view`, docs/command-line.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum View {
     #[default]
@@ -45,7 +45,7 @@ impl Choice for View {
     }
 }
 
-/// ST map (Nuke STMap convention, CONTRACT §1): red and green hold the source
+/// ST map (Nuke STMap convention, docs/coordinates.md): red and green hold the source
 /// position normalised by the source image's extent (`origin`, `size`:
 /// canonical, full resolution), blue 0, alpha 1. Not clamped.
 pub fn stmap<D: Sample>(map: &WarpMap, origin: Vec2, size: Vec2, dst: RowsMut<'_, D>) {

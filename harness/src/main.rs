@@ -1,4 +1,4 @@
-//! `morphfx`: render the MorphFX bundle on plates (CONTRACT §3).
+//! `morphfx`: render the MorphFX bundle on plates (docs/command-line.md).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};

@@ -1,4 +1,4 @@
-//! Warps cached in instance data (DESIGN rule 6): keyed by everything a map
+//! Warps cached in instance data: keyed by everything a map
 //! (or an `auto` correspondence) depends on, shared by concurrent renders of
 //! the same frame (the second thread waits for the first instead of computing
 //! again), bounded in memory.

@@ -1,4 +1,4 @@
-//! The scene: a CONTRACT §2 `*.morph.json` document, parsed, validated and
+//! The scene: a `*.morph.json` document (docs/scene-format.md), parsed, validated and
 //! queried for the features and the progress at any frame.
 
 mod parse;

@@ -1,4 +1,4 @@
-//! Reading a scene: serde for the shape, then every rule of CONTRACT §2 with a
+//! Reading a scene: serde for the shape, then every rule of docs/scene-format.md with a
 //! message that names the feature or keyframe at fault.
 
 use serde::Deserialize;

@@ -1,6 +1,6 @@
 //! One warp abstraction for every method: a reverse map from output positions
 //! to source positions (canonical coordinates), plus dense evaluation over a
-//! window of pixels (DESIGN rule 2).
+//! window of pixels (docs/architecture.md, "Layers").
 
 pub mod auto;
 pub mod field;

@@ -1,4 +1,4 @@
-//! Params as data (DESIGN rule 4): stable ids, labels, hints, defaults, ranges,
+//! Params as data: stable ids, labels, hints, defaults, ranges,
 //! groups. The wrapper turns a table of these into OFX param definitions.
 
 #[derive(Debug, Clone, PartialEq)]

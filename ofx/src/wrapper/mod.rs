@@ -1,6 +1,6 @@
 //! All FFI of the plugin. Each `unsafe` block states why it is sound; every
 //! entry point goes through [`dispatch`], which null-checks, catches unwinds and
-//! maps errors to OFX statuses (DESIGN rule 5).
+//! maps errors to OFX statuses: no panic crosses the C ABI.
 
 pub mod clips;
 pub mod cpu;

@@ -2,7 +2,7 @@
 //! (params, clips, images), [`prepare`] computes what the pixels depend on
 //! (pure given the instance's caches), [`draw`] writes the output rows at
 //! the host's depths. Conversions to pixel rows, render scale and pixel
-//! aspect happen here, once (DESIGN rule 3).
+//! aspect happen here, once: the core sees canonical coordinates only.
 
 mod draw;
 mod inputs;
