@@ -59,11 +59,10 @@ impl WarpSettings {
                         .map(|n| format!(" \"{n}\""))
                         .unwrap_or_default();
                     return Err(Error::Invalid(format!(
-                        "feature {}{name}: its {side} point ({}, {}) lies more than {REACH} frame width{} outside the frame ({}, {}) - ({}, {}); method \"{}\" cannot reach it",
+                        "feature {}{name}: its {side} point ({}, {}) lies more than {REACH}× the frame's width outside the frame ({}, {}) - ({}, {}); method \"{}\" cannot reach it",
                         i + 1,
                         p.x,
                         p.y,
-                        if REACH == 1.0 { "" } else { "s" },
                         frame.x1,
                         frame.y1,
                         frame.x2,

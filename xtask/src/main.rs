@@ -149,6 +149,7 @@ fn main() {
             let mut run = vec!["test", "--workspace"];
             run.extend(args[1..].iter().map(String::as_str));
             cargo(&run);
+            docs();
             refhost::check(&b);
             cmake_install_check();
         }
@@ -159,6 +160,24 @@ fn main() {
             exit(2);
         }
     }
+}
+
+/// `cargo doc --no-deps` with rustdoc's warnings denied: a broken link or
+/// a malformed doc comment fails the tests like a failing test does.
+fn docs() {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let flags = std::env::var("RUSTDOCFLAGS").unwrap_or_default();
+    let status = Command::new(cargo)
+        .args(["doc", "--no-deps", "--workspace", "--quiet"])
+        .env("RUSTDOCFLAGS", format!("{flags} -D warnings"))
+        .current_dir(root())
+        .status()
+        .expect("cargo runs");
+    if !status.success() {
+        eprintln!("cargo doc: rustdoc found the problems above");
+        exit(status.code().unwrap_or(1));
+    }
+    println!("cargo doc: documentation builds with no warnings");
 }
 
 /// The EXR cross-check reads our outputs with OpenImageIO's `oiiotool`;
@@ -234,6 +253,6 @@ fn cmake_install_check() {
 }
 
 fn unsafe_env(key: &str, value: &Path) {
-    // Single-threaded here: setting the variable before spawning cargo is sound.
+    // SAFETY: single-threaded here: setting the variable before spawning cargo is sound.
     unsafe { std::env::set_var(key, value) };
 }

@@ -48,6 +48,7 @@ pub struct Clip {
 // SAFETY: `effect` points at the owning Effect, which outlives its clips and is
 // itself shared between threads only through its own locks.
 unsafe impl Send for Clip {}
+// SAFETY: as for Send; every mutable field is behind a Mutex.
 unsafe impl Sync for Clip {}
 
 #[derive(Debug, Clone, PartialEq)]
@@ -166,6 +167,11 @@ pub(super) fn live_effect<'a>(h: *const c_void) -> Option<&'a Effect> {
     }
 }
 
+/// The clip behind a handle, `None` for null.
+///
+/// # Safety
+/// `h` is null or a handle this host's clipGetHandle gave out, whose effect
+/// is still alive (OFX requires a plugin to pass only such handles).
 unsafe fn clip_of<'a>(h: OfxImageClipHandle) -> Option<&'a Clip> {
     // SAFETY: clip handles we hand out point at boxed Clips of a live effect.
     unsafe { (h as *const Clip).as_ref() }
@@ -258,6 +264,7 @@ unsafe extern "C" fn clip_get_property_set(
     clip: OfxImageClipHandle,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
+    // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
     let Some(c) = (unsafe { clip_of(clip) }) else {
         return kOfxStatErrBadHandle;
     };
@@ -339,6 +346,7 @@ unsafe extern "C" fn clip_get_image(
     _region: *const OfxRectD,
     image: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
+    // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
     let Some(c) = (unsafe { clip_of(clip) }) else {
         return kOfxStatErrBadHandle;
     };
@@ -414,6 +422,7 @@ unsafe extern "C" fn clip_get_rod(
     time: OfxTime,
     bounds: *mut OfxRectD,
 ) -> OfxStatus {
+    // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
     let Some(c) = (unsafe { clip_of(clip) }) else {
         return kOfxStatErrBadHandle;
     };
@@ -583,10 +592,8 @@ mod tests {
         );
         let mut rb = 0;
         // SAFETY: `h` is a live set made above; the out-pointer is ours.
-        assert_eq!(
-            unsafe { get(h, kOfxImagePropRowBytes.as_ptr(), 0, &mut rb) },
-            kOfxStatOK
-        );
+        let status = unsafe { get(h, kOfxImagePropRowBytes.as_ptr(), 0, &mut rb) };
+        assert_eq!(status, kOfxStatOK);
         assert_eq!(rb, 256);
         // SAFETY: as above; the host keeps released sets, so these calls are sound.
         unsafe {

@@ -1000,7 +1000,12 @@ impl Drop for Instance<'_> {
 // host struct and its property set are only read after loading. OFX renders
 // may be called from any thread for a plugin that declares itself thread safe.
 unsafe impl Send for PluginInfo {}
+// SAFETY: as above.
 unsafe impl Sync for PluginInfo {}
+// SAFETY: as above: a bundle is its library and its plugins' info.
 unsafe impl Send for Bundle {}
+// SAFETY: as above.
 unsafe impl Sync for Bundle {}
+// SAFETY: an instance's host state is behind its own locks, and the plugin
+// declares its renders fully thread safe.
 unsafe impl Sync for Instance<'_> {}

@@ -485,6 +485,7 @@ pub unsafe extern "C" fn mfx_param_set(
         return kOfxStatErrBadHandle;
     };
     let mut v = ParamValue::default();
+    // SAFETY: the caller's `d` and `iv` point at four values each.
     unsafe {
         for k in 0..4 {
             v.d[k] = *d.add(k);

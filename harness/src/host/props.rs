@@ -193,7 +193,7 @@ unsafe extern "C" fn get_any(
         return kOfxStatErrUnknown;
     };
     let i = index as usize;
-    // SAFETY (all arms): `out` points at the plugin's variable of the type the
+    // SAFETY: (all arms) `out` points at the plugin's variable of the type the
     // called getter names; string pointers stay valid until the property is set again.
     unsafe {
         match (kind, v) {

@@ -4,13 +4,65 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// The bundle `cargo xtask test` built (MORPHFX_BUNDLE), else the checkout's.
+/// The bundle `cargo xtask test` built (MORPHFX_BUNDLE), else the
+/// checkout's. Refused, in one line that says what to run, when it is
+/// missing or older than the plugin's sources: tests of a stale bundle
+/// would pass or fail for code that is no longer there.
 pub fn bundle_path() -> PathBuf {
-    std::env::var("MORPHFX_BUNDLE")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
+    static CHECKED: std::sync::OnceLock<Result<PathBuf, String>> = std::sync::OnceLock::new();
+    CHECKED
+        .get_or_init(|| {
+            let path = std::env::var("MORPHFX_BUNDLE")
+                .map(PathBuf::from)
+                .unwrap_or_else(|_| {
+                    Path::new(env!("CARGO_MANIFEST_DIR"))
+                        .join("../target/bundle/MorphFX.ofx.bundle")
+                });
+            check_bundle(&path).map(|()| path)
         })
+        .clone()
+        .unwrap_or_else(|why| panic!("{why}: run `cargo xtask test`, which builds it first"))
+}
+
+/// The bundle's binary exists and is newer than every source it is built from.
+fn check_bundle(bundle: &Path) -> Result<(), String> {
+    let arch = if cfg!(target_arch = "aarch64") {
+        "Linux-arm-64"
+    } else {
+        "Linux-x86-64"
+    };
+    let binary = bundle.join("Contents").join(arch).join("MorphFX.ofx");
+    let built = std::fs::metadata(&binary)
+        .and_then(|m| m.modified())
+        .map_err(|_| format!("no plugin bundle at {}", bundle.display()))?;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut newest: Option<(std::time::SystemTime, PathBuf)> = None;
+    for dir in ["src", "ofx/src"] {
+        newest_in(&root.join(dir), &mut newest);
+    }
+    for file in ["Cargo.toml", "ofx/Cargo.toml", "Cargo.lock"] {
+        newest_in(&root.join(file), &mut newest);
+    }
+    match newest {
+        Some((changed, source)) if changed > built => Err(format!(
+            "the plugin bundle at {} is older than {}",
+            bundle.display(),
+            source.display()
+        )),
+        _ => Ok(()),
+    }
+}
+
+fn newest_in(path: &Path, newest: &mut Option<(std::time::SystemTime, PathBuf)>) {
+    if path.is_dir() {
+        for entry in std::fs::read_dir(path).into_iter().flatten().flatten() {
+            newest_in(&entry.path(), newest);
+        }
+    } else if let Ok(t) = std::fs::metadata(path).and_then(|m| m.modified()) {
+        if newest.as_ref().is_none_or(|(n, _)| t > *n) {
+            *newest = Some((t, path.to_owned()));
+        }
+    }
 }
 
 /// An empty folder for one test of this process.

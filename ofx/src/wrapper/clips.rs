@@ -76,10 +76,8 @@ impl Effect {
         let n = CString::new(name).unwrap_or_default();
         let mut p: OfxPropertySetHandle = std::ptr::null_mut();
         // SAFETY: descriptor handle from the host; name NUL-terminated; out-pointer live.
-        check(
-            unsafe { f(self.handle, n.as_ptr(), &mut p) },
-            &format!("defining clip {name}"),
-        )?;
+        let status = unsafe { f(self.handle, n.as_ptr(), &mut p) };
+        check(status, &format!("defining clip {name}"))?;
         // SAFETY: the host just returned the clip descriptor's properties.
         unsafe { PropSet::from_raw(p) }
     }
@@ -93,10 +91,8 @@ impl Effect {
         let n = CString::new(name).unwrap_or_default();
         let mut h: OfxImageClipHandle = std::ptr::null_mut();
         // SAFETY: instance handle from the host; name NUL-terminated; out-pointer live.
-        check(
-            unsafe { f(self.handle, n.as_ptr(), &mut h, std::ptr::null_mut()) },
-            &format!("clip {name}"),
-        )?;
+        let status = unsafe { f(self.handle, n.as_ptr(), &mut h, std::ptr::null_mut()) };
+        check(status, &format!("clip {name}"))?;
         if h.is_null() {
             return Err(Failure::Status(
                 kOfxStatErrBadHandle,
@@ -220,10 +216,8 @@ impl Clip {
             y2: 0.0,
         };
         // SAFETY: clip handle from the host; out-pointer live.
-        check(
-            unsafe { f(self.handle, time, &mut r) },
-            &format!("RoD of clip {}", self.name),
-        )?;
+        let status = unsafe { f(self.handle, time, &mut r) };
+        check(status, &format!("RoD of clip {}", self.name))?;
         Ok(r)
     }
 

@@ -33,9 +33,16 @@ pub unsafe fn dispatch(
     }
     // SAFETY: the host passes a NUL-terminated action name (checked non-null).
     let action = unsafe { CStr::from_ptr(action) };
-    // SAFETY (all three): handles of this action, per this function's contract.
-    let effect = (!handle.is_null()).then(|| unsafe { Effect::from_raw(handle) });
-    let args = |p: OfxPropertySetHandle| (!p.is_null()).then(|| unsafe { PropSet::from_raw(p) });
+    let effect = (!handle.is_null()).then(|| {
+        // SAFETY: the action's effect handle, per this function's contract.
+        unsafe { Effect::from_raw(handle) }
+    });
+    let args = |p: OfxPropertySetHandle| {
+        (!p.is_null()).then(|| {
+            // SAFETY: one of the action's property sets, per this function's contract.
+            unsafe { PropSet::from_raw(p) }
+        })
+    };
     let (in_args, out_args) = (args(in_args), args(out_args));
     let result = catch_unwind(AssertUnwindSafe(|| {
         let forced = &super::host::switches().force_panic;

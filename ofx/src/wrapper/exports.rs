@@ -21,6 +21,7 @@ struct Statics {
 // SAFETY: the plugin structs hold pointers to the `ids` CStrings and to
 // immutable statics only; nothing is ever written after initialisation.
 unsafe impl Send for Statics {}
+// SAFETY: as above.
 unsafe impl Sync for Statics {}
 
 static STATICS: OnceLock<Statics> = OnceLock::new();

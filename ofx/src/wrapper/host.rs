@@ -27,6 +27,7 @@ pub struct Suites {
 // the host calls us on (the suites we use are documented thread safe for
 // render-time use, or we only use them on the threads the spec allows).
 unsafe impl Send for Suites {}
+// SAFETY: as above.
 unsafe impl Sync for Suites {}
 
 static SUITES: RwLock<Option<Suites>> = RwLock::new(None);

@@ -222,6 +222,7 @@ pub struct Params {
 // values through them concurrently, and writes (instanceChanged only) are
 // the host's to serialise. The map itself is never changed after `bind`.
 unsafe impl Send for Params {}
+// SAFETY: as above.
 unsafe impl Sync for Params {}
 
 impl Params {
@@ -253,10 +254,8 @@ impl Params {
         let (h, f) = self.get_at(id)?;
         let mut v = 0.0f64;
         // SAFETY: a Double param takes one `double*` vararg (OFX param suite).
-        check(
-            unsafe { f(h, time, &mut v as *mut f64) },
-            &format!("reading {id}"),
-        )?;
+        let status = unsafe { f(h, time, &mut v as *mut f64) };
+        check(status, &format!("reading {id}"))?;
         Ok(v)
     }
 
@@ -265,10 +264,8 @@ impl Params {
         let (h, f) = self.get_at(id)?;
         let mut v: c_int = 0;
         // SAFETY: Integer, Boolean and Choice params take one `int*` vararg.
-        check(
-            unsafe { f(h, time, &mut v as *mut c_int) },
-            &format!("reading {id}"),
-        )?;
+        let status = unsafe { f(h, time, &mut v as *mut c_int) };
+        check(status, &format!("reading {id}"))?;
         Ok(v)
     }
 
@@ -276,10 +273,8 @@ impl Params {
         let (h, f) = self.get_at(id)?;
         let (mut x, mut y) = (0.0f64, 0.0f64);
         // SAFETY: a Double2D param takes two `double*` varargs.
-        check(
-            unsafe { f(h, time, &mut x as *mut f64, &mut y as *mut f64) },
-            &format!("reading {id}"),
-        )?;
+        let status = unsafe { f(h, time, &mut x as *mut f64, &mut y as *mut f64) };
+        check(status, &format!("reading {id}"))?;
         Ok((x, y))
     }
 
@@ -305,10 +300,8 @@ impl Params {
         };
         let label = cstr(name);
         // SAFETY: the instance's param set and a NUL-terminated label.
-        check(
-            unsafe { begin(self.set.set, label.as_ptr()) },
-            "paramEditBegin",
-        )?;
+        let status = unsafe { begin(self.set.set, label.as_ptr()) };
+        check(status, "paramEditBegin")?;
         let result = writes();
         // SAFETY: closes the block opened just above on the same set.
         let closed = check(unsafe { end(self.set.set) }, "paramEditEnd");
@@ -320,10 +313,8 @@ impl Params {
         let (h, f) = self.get_at(id)?;
         let mut v: *const c_char = std::ptr::null();
         // SAFETY: a String param takes one `char**` vararg; the host owns the result.
-        check(
-            unsafe { f(h, time, &mut v as *mut *const c_char) },
-            &format!("reading {id}"),
-        )?;
+        let status = unsafe { f(h, time, &mut v as *mut *const c_char) };
+        check(status, &format!("reading {id}"))?;
         if v.is_null() {
             return Ok(String::new());
         }

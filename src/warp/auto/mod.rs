@@ -4,7 +4,7 @@
 //! (re-colouring + stretching + angle change + anchor penalties); the morph
 //! then blends A's lattice with `F`'s control points ([`QuadWarp`]).
 //!
-//! Flow: plates → [`WorkImage`]s → [`solve`] (level by level, [`optimise`])
+//! Flow: plates → [`WorkImage`]s → [`solve`] (level by level, `optimise`)
 //! → [`Correspondence`] (the grid placed on the two frames) → per-side
 //! reverse maps toward `t` like every other method.
 

@@ -41,7 +41,7 @@ pub enum Evaluation {
     /// Eq. (1)–(4) at every pixel.
     Exact,
     /// A coarse grid refined where bilinear interpolation would err by more
-    /// than `tolerance` pixels ([`adaptive`]).
+    /// than `tolerance` pixels ([`split`]).
     Adaptive { tolerance: f64 },
 }
 

@@ -52,7 +52,7 @@ impl ThinPlate {
     /// The plates whose displacements carry each `from` to its `to`, over
     /// `frame`. `warm`: a previous solution on the same grid to start from
     /// (a sequence's previous frame), else the plates start flat. Features
-    /// on one point or one line are completed by [`pinning`] so that the
+    /// on one point or one line are completed by `pinning` so that the
     /// plates are unique, whatever the start.
     pub fn solve(
         pairs: &[(Vec2, Vec2)],
