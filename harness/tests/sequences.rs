@@ -152,6 +152,26 @@ fn a_sequence_render_equals_single_frame_renders_whatever_the_chunking() {
     assert_ne!(mid, a);
 }
 
+/// `morphfx morph` of `src` with itself at `t` through `scene` into `out`,
+/// with an optional flag.
+fn morph_itself(scene: &Path, src: &Path, t: &str, out: &Path, flag: Option<&str>) {
+    let mut args = vec![
+        "morph",
+        "--scene",
+        s(scene),
+        "--a",
+        s(src),
+        "--b",
+        s(src),
+        "--t",
+        t,
+        "-o",
+        s(out),
+    ];
+    args.extend(flag);
+    morphfx(&args);
+}
+
 #[test]
 fn float_and_half_exr_round_trip_bit_exactly() {
     let d = tmp("exr");
@@ -174,21 +194,7 @@ fn float_and_half_exr_round_trip_bit_exactly() {
         )
         .unwrap();
         let (out, scene) = (d.join("out.exr"), d.join("s.morph.json"));
-        let mut args = vec![
-            "morph",
-            "--scene",
-            s(&scene),
-            "--a",
-            s(&src),
-            "--b",
-            s(&src),
-            "--t",
-            "0",
-            "-o",
-            s(&out),
-        ];
-        args.extend(flag);
-        morphfx(&args);
+        morph_itself(&scene, &src, "0", &out, flag);
         assert_eq!(
             io::read(&out).unwrap().image,
             read.image,
@@ -230,21 +236,7 @@ fn outputs_keep_the_inputs_precision_unless_told() {
         let src = d.join("src.exr");
         write_plate(&src, 40, 24, 0.5, input);
         let out = d.join("out.exr");
-        let mut args = vec![
-            "morph",
-            "--scene",
-            s(&scene),
-            "--a",
-            s(&src),
-            "--b",
-            s(&src),
-            "--t",
-            "0.5",
-            "-o",
-            s(&out),
-        ];
-        args.extend(flag);
-        morphfx(&args);
+        morph_itself(&scene, &src, "0.5", &out, flag);
         assert_eq!(written_half(&out), want_half, "{input:?} with {flag:?}");
     }
 }

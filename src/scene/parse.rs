@@ -107,48 +107,13 @@ impl Scene {
                 e.to_string(),
             )
         })?;
-        if let Some(f) = &raw.format {
-            if f != FORMAT {
-                return Err(Error::scene(
-                    "format",
-                    format!("expected \"{FORMAT}\", found \"{f}\""),
-                ));
-            }
-        }
-        if let Some(v) = raw.version {
-            if v != 1 {
-                return Err(Error::scene(
-                    "version",
-                    format!("version {v} is not supported (this build reads version 1)"),
-                ));
-            }
-        }
-        let method = match &raw.method {
-            None => Method::Field,
-            Some(m) => Method::parse(m).ok_or_else(|| {
-                Error::scene(
-                    "method",
-                    format!(
-                        "unknown method \"{m}\" (one of {})",
-                        Method::names().join(", ")
-                    ),
-                )
-            })?,
-        };
+        check_header(&raw)?;
+        let method = method(raw.method.as_deref())?;
         let field = match raw.field {
             Some(f) => field_settings(f)?,
             None => FieldSettings::default(),
         };
-        let samples_per_segment = match raw.sampling {
-            Some(s) if s.samples_per_segment == 0 || s.samples_per_segment > 1000 => {
-                return Err(Error::scene(
-                    "sampling.samples_per_segment",
-                    "must be between 1 and 1000",
-                ))
-            }
-            Some(s) => s.samples_per_segment,
-            None => crate::features::DEFAULT_SAMPLES_PER_SEGMENT,
-        };
+        let samples_per_segment = samples_per_segment(raw.sampling.as_ref())?;
 
         let (mesh, meshes) = match raw.mesh {
             Some(m) => mesh(m)?,
@@ -209,6 +174,55 @@ impl Scene {
             ));
         }
         Ok(scene)
+    }
+}
+
+/// The document says it is a MorphFX scene of a version this build reads.
+fn check_header(raw: &RawScene) -> Result<()> {
+    if let Some(f) = &raw.format {
+        if f != FORMAT {
+            return Err(Error::scene(
+                "format",
+                format!("expected \"{FORMAT}\", found \"{f}\""),
+            ));
+        }
+    }
+    if let Some(v) = raw.version {
+        if v != 1 {
+            return Err(Error::scene(
+                "version",
+                format!("version {v} is not supported (this build reads version 1)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The scene's `method`, `field` when absent.
+fn method(name: Option<&str>) -> Result<Method> {
+    let Some(m) = name else {
+        return Ok(Method::Field);
+    };
+    Method::parse(m).ok_or_else(|| {
+        Error::scene(
+            "method",
+            format!(
+                "unknown method \"{m}\" (one of {})",
+                Method::names().join(", ")
+            ),
+        )
+    })
+}
+
+/// `sampling.samples_per_segment`, within 1..=1000.
+fn samples_per_segment(sampling: Option<&RawSampling>) -> Result<usize> {
+    match sampling {
+        Some(s) if s.samples_per_segment == 0 || s.samples_per_segment > 1000 => Err(Error::scene(
+            "sampling.samples_per_segment",
+            "must be between 1 and 1000",
+        )),
+        Some(s) => Ok(s.samples_per_segment),
+        None => Ok(crate::features::DEFAULT_SAMPLES_PER_SEGMENT),
     }
 }
 
