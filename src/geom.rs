@@ -1,11 +1,15 @@
 //! Plain 2-D geometry in canonical coordinates (f64: feature math wants the headroom).
+#![deny(missing_docs)]
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(from = "[f64; 2]", into = "[f64; 2]")]
+/// A point or a vector; in scene files, `[x, y]`.
 pub struct Vec2 {
+    /// Rightwards.
     pub x: f64,
+    /// Upwards.
     pub y: f64,
 }
 
@@ -24,11 +28,14 @@ impl From<Vec2> for [f64; 2] {
 }
 
 impl Vec2 {
+    /// The origin, and the zero vector.
     pub const ZERO: Vec2 = Vec2 { x: 0.0, y: 0.0 };
 
+    /// `(x, y)`.
     pub const fn new(x: f64, y: f64) -> Self {
         Vec2 { x, y }
     }
+    /// The dot product.
     #[inline]
     pub fn dot(self, o: Vec2) -> f64 {
         self.x * o.x + self.y * o.y
@@ -39,22 +46,27 @@ impl Vec2 {
     pub fn perp(self) -> Vec2 {
         Vec2::new(-self.y, self.x)
     }
+    /// The squared length (no square root).
     #[inline]
     pub fn length_squared(self) -> f64 {
         self.dot(self)
     }
+    /// The Euclidean length.
     #[inline]
     pub fn length(self) -> f64 {
         self.length_squared().sqrt()
     }
+    /// `self` at `t = 0`, `o` at `t = 1`, on the line between elsewhere.
     #[inline]
     pub fn lerp(self, o: Vec2, t: f64) -> Vec2 {
         Vec2::new(self.x + (o.x - self.x) * t, self.y + (o.y - self.y) * t)
     }
+    /// Neither coordinate is infinite or NaN.
     #[inline]
     pub fn is_finite(self) -> bool {
         self.x.is_finite() && self.y.is_finite()
     }
+    /// The Euclidean distance to `o`.
     #[inline]
     pub fn distance(self, o: Vec2) -> f64 {
         (self - o).length()
@@ -119,35 +131,46 @@ impl Neg for Vec2 {
 /// An integer pixel rectangle `[x1, x2) × [y1, y2)` (OFX `OfxRectI` semantics).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct RectI {
+    /// The first column.
     pub x1: i32,
+    /// The first row (from the bottom).
     pub y1: i32,
+    /// One past the last column.
     pub x2: i32,
+    /// One past the last row.
     pub y2: i32,
 }
 
 impl RectI {
+    /// `[x1, x2) × [y1, y2)`.
     pub const fn new(x1: i32, y1: i32, x2: i32, y2: i32) -> Self {
         RectI { x1, y1, x2, y2 }
     }
+    /// `width × height` pixels from the origin.
     pub const fn from_size(width: usize, height: usize) -> Self {
         RectI::new(0, 0, width as i32, height as i32)
     }
+    /// Columns (0 when inverted).
     #[inline]
     pub fn width(&self) -> usize {
         (self.x2 - self.x1).max(0) as usize
     }
+    /// Rows (0 when inverted).
     #[inline]
     pub fn height(&self) -> usize {
         (self.y2 - self.y1).max(0) as usize
     }
+    /// No pixel inside.
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.width() == 0 || self.height() == 0
     }
+    /// Pixels inside.
     #[inline]
     pub fn area(&self) -> usize {
         self.width() * self.height()
     }
+    /// Every pixel of `other` is inside (an empty `other` always is).
     #[inline]
     pub fn contains(&self, other: &RectI) -> bool {
         other.is_empty()
@@ -156,6 +179,7 @@ impl RectI {
                 && other.x2 <= self.x2
                 && other.y2 <= self.y2)
     }
+    /// The pixels inside both; the default (empty) rectangle when none are.
     #[inline]
     pub fn intersect(&self, o: &RectI) -> RectI {
         let r = RectI::new(
@@ -176,36 +200,44 @@ impl RectI {
 /// e.g. the frame a warp must cover.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RectD {
+    /// Left.
     pub x1: f64,
+    /// Bottom.
     pub y1: f64,
+    /// Right.
     pub x2: f64,
+    /// Top.
     pub y2: f64,
 }
 
 impl RectD {
+    /// `[x1, x2] × [y1, y2]`.
     pub const fn new(x1: f64, y1: f64, x2: f64, y2: f64) -> Self {
         RectD { x1, y1, x2, y2 }
     }
+    /// `x2 - x1`.
     #[inline]
     pub fn width(&self) -> f64 {
         self.x2 - self.x1
     }
+    /// `y2 - y1`.
     #[inline]
     pub fn height(&self) -> f64 {
         self.y2 - self.y1
     }
-    /// The smallest rectangle holding this one and every point of `points`.
     /// Whether `p` lies inside or on the border (false for NaN).
     pub fn contains_point(&self, p: Vec2) -> bool {
         self.x1 <= p.x && p.x <= self.x2 && self.y1 <= p.y && p.y <= self.y2
     }
 
+    /// The smallest rectangle holding this one and every point of `points`.
     pub fn including(self, points: impl IntoIterator<Item = Vec2>) -> RectD {
         points.into_iter().fold(self, |r, p| {
             RectD::new(r.x1.min(p.x), r.y1.min(p.y), r.x2.max(p.x), r.y2.max(p.y))
         })
     }
 
+    /// Finite, with positive width and height.
     pub fn is_valid(&self) -> bool {
         [self.x1, self.y1, self.x2, self.y2]
             .iter()
@@ -220,13 +252,17 @@ impl RectD {
 /// folds in the pixel aspect ratio (`render_scale.x / par`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PixelScale {
+    /// Pixels per canonical unit along x (render scale over pixel aspect).
     pub x: f64,
+    /// Pixels per canonical unit along y (the render scale).
     pub y: f64,
 }
 
 impl PixelScale {
+    /// Full resolution, square pixels: pixels are canonical units.
     pub const UNIT: PixelScale = PixelScale { x: 1.0, y: 1.0 };
 
+    /// From a host's render scale and pixel aspect ratio.
     #[inline]
     pub fn new(render_scale_x: f64, render_scale_y: f64, pixel_aspect: f64) -> Self {
         PixelScale {
@@ -239,10 +275,12 @@ impl PixelScale {
     pub fn pixel_centre(&self, i: i32, j: i32) -> Vec2 {
         Vec2::new((i as f64 + 0.5) / self.x, (j as f64 + 0.5) / self.y)
     }
+    /// A canonical position in this scale's pixel units.
     #[inline]
     pub fn to_pixel(&self, p: Vec2) -> Vec2 {
         Vec2::new(p.x * self.x, p.y * self.y)
     }
+    /// Full resolution with square pixels.
     #[inline]
     pub fn is_unit(&self) -> bool {
         *self == PixelScale::UNIT
