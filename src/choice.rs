@@ -15,22 +15,6 @@ pub trait Choice: Copy + PartialEq + Sized + 'static {
         Self::ALL.iter().copied().find(|o| o.name() == name)
     }
 
-    /// The option at `index` of [`Choice::ALL`], if there is one.
-    fn from_index(index: i64) -> Option<Self> {
-        usize::try_from(index)
-            .ok()
-            .and_then(|i| Self::ALL.get(i))
-            .copied()
-    }
-
-    /// The option's index in [`Choice::ALL`].
-    fn index(self) -> usize {
-        Self::ALL
-            .iter()
-            .position(|o| *o == self)
-            .expect("every option is in ALL")
-    }
-
     /// Every option's name, in order.
     fn names() -> Vec<&'static str> {
         Self::ALL.iter().map(|o| o.name()).collect()

@@ -303,6 +303,17 @@ fn prepare<'r>(kind: NodeKind, instance: &'r Instance, request: &'r Request) -> 
     // The two-pass mesh warp makes pixels, not maps; weights need maps.
     let by_map = !(two_pass && picture) || weighted;
     let map = |side| map(instance, request, side);
+    // Weighted implies the Morph view of the Morph node: both maps drawn.
+    let map_a = (needs_a(view) && by_map)
+        .then(|| map(Side::A))
+        .transpose()?;
+    let map_b = (needs_b(kind, view) && by_map)
+        .then(|| map(Side::B))
+        .transpose()?;
+    let weights = match (weighted, &map_a, &map_b) {
+        (true, Some(ma), Some(mb)) => Some(weights(instance, request, ma, mb)?),
+        _ => None,
+    };
     let rates = match view {
         View::Transition => Some(
             inputs
@@ -315,19 +326,12 @@ fn prepare<'r>(kind: NodeKind, instance: &'r Instance, request: &'r Request) -> 
     let (origin, size) = request.project;
     Ok(Job {
         view,
-        weights: match weighted {
-            true => Some(weights(instance, request, map(Side::A)?, map(Side::B)?)?),
-            false => None,
-        },
+        weights,
         rates,
         t: inputs.t,
         features: &inputs.features,
-        map_a: (needs_a(view) && by_map)
-            .then(|| map(Side::A))
-            .transpose()?,
-        map_b: (needs_b(kind, view) && by_map)
-            .then(|| map(Side::B))
-            .transpose()?,
+        map_a,
+        map_b,
         meshes: if by_map {
             None
         } else {
@@ -366,8 +370,8 @@ fn map(instance: &Instance, request: &Request, side: Side) -> Outcome<Arc<WarpMa
 fn weights(
     instance: &Instance,
     request: &Request,
-    ma: Arc<WarpMap>,
-    mb: Arc<WarpMap>,
+    ma: &WarpMap,
+    mb: &WarpMap,
 ) -> Outcome<Arc<transition::Weights>> {
     let inputs = &request.inputs;
     let key = Key::of(&(inputs, "weights", request.window, request.out_scale));
@@ -379,7 +383,7 @@ fn weights(
         // W1 carries B onto A: the warp of A toward B's positions.
         let w1 =
             make_warp::toward(&inputs.features, Side::A, 1.0, &inputs.warp).map_err(bad_input)?;
-        Ok::<_, Failure>(transition::colour_weights(&colour, &ma, &mb, w1.as_ref()))
+        Ok::<_, Failure>(transition::colour_weights(&colour, ma, mb, w1.as_ref()))
     })
 }
 

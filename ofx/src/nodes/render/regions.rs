@@ -16,6 +16,19 @@ use crate::wrapper::clips::Effect;
 use crate::wrapper::props::PropSet;
 use crate::wrapper::{Failure, Outcome, Reply};
 
+/// Each source clip in `context` and the time it is read at for output
+/// time `time` (its frame offset added).
+fn source_times(
+    kind: NodeKind,
+    effect: &Effect,
+    context: &str,
+    time: f64,
+) -> impl Iterator<Item = (&'static str, f64)> {
+    let (a, b) = kind.source_clips(context);
+    let (oa, ob) = offsets(kind, effect, time);
+    std::iter::once((a, time + oa)).chain(b.map(|b| (b, time + ob)))
+}
+
 /// The frame offsets of the sources (params read without a settings pass).
 fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
     let Ok(instance) = instance::get(effect) else {
@@ -44,17 +57,15 @@ pub(super) fn output_region(
     context: &str,
     time: f64,
 ) -> Outcome<OfxRectD> {
-    let (a, b) = kind.source_clips(context);
-    let (oa, ob) = offsets(kind, effect, time);
     let mut union: Option<OfxRectD> = None;
-    for (name, offset) in std::iter::once((a, oa)).chain(b.map(|b| (b, ob))) {
+    for (name, at) in source_times(kind, effect, context, time) {
         let clip = effect.clip(name)?;
         if !clip.is_connected() {
             continue;
         }
         // A connected clip with no region at this time adds none (its
         // image is transparent black, like a failed fetch).
-        let Ok(r) = clip.rod(time + offset) else {
+        let Ok(r) = clip.rod(at) else {
             continue;
         };
         union = Some(match union {
@@ -124,15 +135,12 @@ pub fn regions_of_interest(
     out_args: &PropSet,
 ) -> Outcome {
     let time = in_args.get_double(kOfxPropTime, 0)?;
-    let context = context(effect);
-    let (a, b) = kind.source_clips(&context);
-    let (oa, ob) = offsets(kind, effect, time);
-    for (name, offset) in std::iter::once((a, oa)).chain(b.map(|b| (b, ob))) {
+    for (name, at) in source_times(kind, effect, &context(effect), time) {
         let clip = effect.clip(name)?;
         if !clip.is_connected() {
             continue;
         }
-        if let Ok(rod) = clip.rod(time + offset) {
+        if let Ok(rod) = clip.rod(at) {
             let prop =
                 std::ffi::CString::new(format!("OfxImageClipPropRoI_{name}")).unwrap_or_default();
             out_args.set_doubles(&prop, &[rod.x1, rod.y1, rod.x2, rod.y2])?;
@@ -148,13 +156,10 @@ pub fn frames_needed(
     out_args: &PropSet,
 ) -> Outcome {
     let time = in_args.get_double(kOfxPropTime, 0)?;
-    let (oa, ob) = offsets(kind, effect, time);
-    let context = context(effect);
-    let (a, b) = kind.source_clips(&context);
-    for (name, off) in std::iter::once((a, oa)).chain(b.map(|b| (b, ob))) {
+    for (name, at) in source_times(kind, effect, &context(effect), time) {
         let prop = std::ffi::CString::new(format!("OfxImageClipPropFrameRange_{name}"))
             .unwrap_or_default();
-        out_args.set_doubles(&prop, &[time + off, time + off])?;
+        out_args.set_doubles(&prop, &[at, at])?;
     }
     Ok(())
 }
