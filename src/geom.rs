@@ -1,5 +1,4 @@
 //! Plain 2-D geometry in canonical coordinates (f64: feature math wants the headroom).
-#![deny(missing_docs)]
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 

@@ -8,6 +8,9 @@
 //! x right, **y up**, origin at the bottom-left corner, pixel `(i, j)` centred
 //! at `(i + 0.5, j + 0.5)` (docs/coordinates.md).
 #![forbid(unsafe_code)]
+// Every public item says what it is: the core is the API the plugin and
+// the harness are written against.
+#![deny(missing_docs)]
 
 pub mod bspline;
 pub mod choice;

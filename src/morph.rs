@@ -11,7 +11,9 @@ use crate::transition::Weights;
 /// map, or pixels a warp made directly (the two-pass mesh warp).
 #[derive(Clone, Copy)]
 pub enum Warped<'a, S> {
+    /// A source sampled through a reverse map.
     Map(&'a Sampler<'a, S>, &'a WarpMap),
+    /// Pixels a warp made directly.
     Pixels(&'a Plane),
     /// A straight-alpha source's warped pixels with colour times alpha, to
     /// meet premultiplied pixels in a dissolve or a premultiplied output.
@@ -21,6 +23,7 @@ pub enum Warped<'a, S> {
 }
 
 impl<S: Sample> Warped<'_, S> {
+    /// Components per pixel.
     pub fn channels(&self) -> usize {
         match self {
             Warped::Map(s, _) => s.channels(),

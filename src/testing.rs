@@ -55,6 +55,7 @@ pub fn texture(p: Vec2) -> [f32; 3] {
 pub struct Lcg(u64);
 
 impl Lcg {
+    /// A generator started from `seed`.
     pub fn new(seed: u64) -> Self {
         Lcg(seed
             .wrapping_mul(6364136223846793005)

@@ -12,13 +12,20 @@ use crate::transition::Rates;
 /// The output view a node renders (the command line's `--view`, docs/command-line.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum View {
+    /// The morph: warped A and B dissolved.
     #[default]
     Morph,
+    /// A warped toward the in-between features.
     WarpedA,
+    /// B warped toward the in-between features.
     WarpedB,
+    /// A's reverse map as an ST map (normalised source positions in red and green).
     StmapA,
+    /// B's reverse map as an ST map.
     StmapB,
+    /// The colour transition rates, grey.
     Transition,
+    /// A grid warped like A, to show the warp's shape.
     Grid,
 }
 

@@ -10,15 +10,20 @@ use crate::geom::{PixelScale, RectI, Vec2};
 /// lattice's edge.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lattice {
+    /// Canonical position of control `(0, 0)`.
     pub origin: Vec2,
+    /// Control spacing (canonical px).
     pub h: f64,
+    /// Controls stored in x.
     pub nx: usize,
+    /// Controls stored in y.
     pub ny: usize,
     /// Row-major, `j * nx + i`.
     pub phi: Vec<f64>,
 }
 
 impl Lattice {
+    /// A lattice of `nx × ny` zero controls: the zero function.
     pub fn zero(origin: Vec2, h: f64, nx: usize, ny: usize) -> Self {
         Lattice {
             origin,
@@ -37,6 +42,7 @@ impl Lattice {
         Lattice::zero(origin, h, cells(min.x, max.x) + 3, cells(min.y, max.y) + 3)
     }
 
+    /// Control `(i, j)`; zero outside the stored array.
     #[inline]
     pub fn get(&self, i: i64, j: i64) -> f64 {
         if i < 0 || j < 0 || i >= self.nx as i64 || j >= self.ny as i64 {
@@ -62,6 +68,7 @@ impl Lattice {
         c >= 1 && r >= 1 && c + 2 < self.nx as i64 && r + 2 < self.ny as i64
     }
 
+    /// The cubic B-spline function at `p` (canonical).
     pub fn eval(&self, p: Vec2) -> f64 {
         let (c, r, s, t) = self.locate(p);
         let (bs, bt) = (basis(s), basis(t));

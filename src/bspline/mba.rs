@@ -9,6 +9,7 @@
 use super::{Approximation, Lattice};
 use crate::geom::Vec2;
 
+/// Multilevel B-spline approximation settings (Lee, Wolberg et al. §6.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MbaSettings {
     /// Cells of the coarsest lattice across the longer side of the domain
@@ -33,6 +34,7 @@ impl Default for MbaSettings {
 /// An interpolating surface and how well it met its points.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Surface {
+    /// The sum of every level's lattice, refined into one.
     pub lattice: Lattice,
     /// Largest `|f(p) − value|` over the points.
     pub error: f64,
@@ -41,6 +43,7 @@ pub struct Surface {
 }
 
 impl Surface {
+    /// The surface's value at `p`.
     pub fn eval(&self, p: Vec2) -> f64 {
         self.lattice.eval(p)
     }

@@ -9,17 +9,21 @@ pub use sampling::{sample_points, PointPair, DEFAULT_SAMPLES_PER_SEGMENT};
 
 use crate::geom::Vec2;
 
+/// The shape of a feature: what its points mean.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum FeatureKind {
+    /// A single point.
     Point,
     /// A directed segment P → Q.
     Line,
+    /// Straight segments through its points, in order.
     Polyline,
     /// Catmull-Rom spline through its control points.
     Curve,
 }
 
 impl FeatureKind {
+    /// Every kind, in the order the scene format lists them.
     pub const ALL: [FeatureKind; 4] = [
         FeatureKind::Point,
         FeatureKind::Line,
@@ -27,6 +31,7 @@ impl FeatureKind {
         FeatureKind::Curve,
     ];
 
+    /// The kind's name in scene files.
     pub fn name(self) -> &'static str {
         match self {
             FeatureKind::Point => "point",
@@ -36,6 +41,7 @@ impl FeatureKind {
         }
     }
 
+    /// The kind named `s` in a scene file, if any.
     pub fn parse(s: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == s)
     }
@@ -54,20 +60,27 @@ impl FeatureKind {
 /// `a.len() == b.len()` is an invariant (the scene parser enforces it).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Feature {
+    /// The user's name for it, used in messages and transition attachments.
     pub name: Option<String>,
+    /// What the points describe.
     pub kind: FeatureKind,
+    /// Control points on image A (canonical).
     pub a: Vec<Vec2>,
+    /// Control points on image B, one per point on A.
     pub b: Vec<Vec2>,
 }
 
 /// Where a feature sits on one image, or in between.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Side {
+    /// Image A, the start of the morph.
     A,
+    /// Image B, the end of the morph.
     B,
 }
 
 impl Feature {
+    /// An unnamed feature of `kind` with points `a` on A and `b` on B.
     pub fn new(kind: FeatureKind, a: Vec<Vec2>, b: Vec<Vec2>) -> Self {
         Feature {
             name: None,
@@ -77,19 +90,23 @@ impl Feature {
         }
     }
 
+    /// A directed line: `a[0] → a[1]` on A, `b[0] → b[1]` on B.
     pub fn line(a: [Vec2; 2], b: [Vec2; 2]) -> Self {
         Feature::new(FeatureKind::Line, a.to_vec(), b.to_vec())
     }
 
+    /// A point at `a` on A and `b` on B.
     pub fn point(a: Vec2, b: Vec2) -> Self {
         Feature::new(FeatureKind::Point, vec![a], vec![b])
     }
 
+    /// The same feature with a name.
     pub fn named(mut self, name: impl Into<String>) -> Self {
         self.name = Some(name.into());
         self
     }
 
+    /// The control points on `side`.
     pub fn points(&self, side: Side) -> &[Vec2] {
         match side {
             Side::A => &self.a,
@@ -120,11 +137,13 @@ impl Feature {
 /// position on A (transition control, Lee, Wolberg et al. §3: `T0(p; t)`).
 #[derive(Clone, Copy)]
 pub struct Tween<'a> {
+    /// The progress, `0` (A) to `1` (B).
     pub t: f64,
     rate: Option<&'a (dyn Fn(Vec2) -> f64 + Sync)>,
 }
 
 impl<'a> Tween<'a> {
+    /// Every point at progress `t`.
     pub fn uniform(t: f64) -> Self {
         Tween { t, rate: None }
     }
@@ -137,6 +156,7 @@ impl<'a> Tween<'a> {
         }
     }
 
+    /// True when every point moves at the same rate `t`.
     pub fn is_uniform(&self) -> bool {
         self.rate.is_none()
     }

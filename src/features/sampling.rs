@@ -5,12 +5,15 @@
 use super::{catmull_rom, Feature, FeatureKind, Side};
 use crate::geom::Vec2;
 
+/// Samples per polyline or curve span when a method needs scattered points.
 pub const DEFAULT_SAMPLES_PER_SEGMENT: usize = 20;
 
 /// A corresponding pair of positions on A and B.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointPair {
+    /// Position on A.
     pub a: Vec2,
+    /// Position on B.
     pub b: Vec2,
 }
 
@@ -33,6 +36,8 @@ impl Feature {
     }
 }
 
+/// `points` of a feature of `kind` sampled `per_segment` times per span (the end point
+/// once); points and lines give their control points.
 pub fn sample_points(kind: FeatureKind, points: &[Vec2], per_segment: usize) -> Vec<Vec2> {
     let per_segment = per_segment.max(1);
     match kind {

@@ -19,7 +19,9 @@ use crate::geom::RectI;
 
 /// A pixel component type a host may send: 8-bit, 16-bit or 32-bit float.
 pub trait Sample: Copy + Send + Sync + Default + PartialEq + std::fmt::Debug + 'static {
+    /// The sample as a float (8- and 16-bit scaled to `[0, 1]`).
     fn to_f32(self) -> f32;
+    /// The nearest sample to `v` (clamped for integer types).
     fn from_f32(v: f32) -> Self;
 
     /// The first eight samples of `s` as floats.
@@ -90,7 +92,9 @@ impl Sample for u16 {
 /// Where each row of a view lives in its slice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Layout {
+    /// Pixels covered (at the image's own scale).
     pub bounds: RectI,
+    /// Components per pixel, 1 to 4.
     pub channels: usize,
     /// Index of pixel `(x1, y1)`.
     pub base: usize,
@@ -146,6 +150,7 @@ impl Layout {
     }
 }
 
+/// A read-only image borrowed from someone else's buffer (a host's, or an [`Image`]).
 #[derive(Debug, Clone, Copy)]
 pub struct ImageView<'a, T> {
     data: &'a [T],
@@ -153,14 +158,18 @@ pub struct ImageView<'a, T> {
 }
 
 impl<'a, T: Sample> ImageView<'a, T> {
+    /// A view of `data` laid out as `layout`; refused when the layout reaches outside
+    /// `data`.
     pub fn new(data: &'a [T], layout: Layout) -> Result<Self> {
         layout.check(data.len())?;
         Ok(ImageView { data, layout })
     }
+    /// Pixels covered.
     #[inline]
     pub fn bounds(&self) -> RectI {
         self.layout.bounds
     }
+    /// Components per pixel.
     #[inline]
     pub fn channels(&self) -> usize {
         self.layout.channels
@@ -180,6 +189,7 @@ impl<'a, T: Sample> ImageView<'a, T> {
     }
 }
 
+/// A writable image borrowed from someone else's buffer.
 #[derive(Debug)]
 pub struct ImageViewMut<'a, T> {
     data: &'a mut [T],
@@ -187,18 +197,23 @@ pub struct ImageViewMut<'a, T> {
 }
 
 impl<'a, T: Sample> ImageViewMut<'a, T> {
+    /// A writable view of `data` laid out as `layout`; refused when the layout reaches
+    /// outside `data`.
     pub fn new(data: &'a mut [T], layout: Layout) -> Result<Self> {
         layout.check(data.len())?;
         Ok(ImageViewMut { data, layout })
     }
+    /// Pixels covered.
     #[inline]
     pub fn bounds(&self) -> RectI {
         self.layout.bounds
     }
+    /// Components per pixel.
     #[inline]
     pub fn channels(&self) -> usize {
         self.layout.channels
     }
+    /// The same pixels, read-only.
     pub fn as_view(&self) -> ImageView<'_, T> {
         ImageView {
             data: self.data,
@@ -242,20 +257,27 @@ impl<'a, T: Sample> ImageViewMut<'a, T> {
 /// only the rows (and columns) of their own window, never the whole buffer.
 #[derive(Debug)]
 pub struct RowsMut<'a, T> {
+    /// Pixels covered, the union of the rows.
     pub bounds: RectI,
+    /// Components per pixel.
     pub channels: usize,
+    /// `(j, pixels x1..x2 of row j)`, bottom row first.
     pub rows: Vec<(i32, &'a mut [T])>,
 }
 
 /// An owned float image: packed rows, bottom row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
+    /// Pixels covered.
     pub bounds: RectI,
+    /// Components per pixel.
     pub channels: usize,
+    /// `bounds.area() × channels` samples, bottom row first.
     pub data: Vec<f32>,
 }
 
 impl Image {
+    /// A black (all zero) image.
     pub fn new(bounds: RectI, channels: usize) -> Self {
         Image {
             bounds,
@@ -263,6 +285,7 @@ impl Image {
             data: vec![0.0; bounds.area() * channels],
         }
     }
+    /// An image whose sample `(i, j, c)` is `f(i, j, c)`.
     pub fn from_fn(bounds: RectI, channels: usize, f: impl Fn(i32, i32, usize) -> f32) -> Self {
         let mut img = Image::new(bounds, channels);
         let mut k = 0;
@@ -276,24 +299,30 @@ impl Image {
         }
         img
     }
+    /// Pixels across.
     #[inline]
     pub fn width(&self) -> usize {
         self.bounds.width()
     }
+    /// Pixels up.
     #[inline]
     pub fn height(&self) -> usize {
         self.bounds.height()
     }
+    /// The layout of [`Image::data`].
     pub fn layout(&self) -> Layout {
         Layout::packed(self.bounds, self.channels)
     }
+    /// The image as a read-only view.
     pub fn view(&self) -> ImageView<'_, f32> {
         ImageView::new(&self.data, self.layout()).expect("packed layout fits its buffer")
     }
+    /// The image as a writable view.
     pub fn view_mut(&mut self) -> ImageViewMut<'_, f32> {
         let layout = self.layout();
         ImageViewMut::new(&mut self.data, layout).expect("packed layout fits its buffer")
     }
+    /// The samples of pixel `(i, j)`, which must lie inside `bounds`.
     #[inline]
     pub fn pixel(&self, i: i32, j: i32) -> &[f32] {
         let k = ((j - self.bounds.y1) as usize * self.width() + (i - self.bounds.x1) as usize)
@@ -310,8 +339,11 @@ mod tests;
 /// than a map (the two-pass mesh warp) hands to the dissolve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plane {
+    /// Pixels covered.
     pub window: RectI,
+    /// Channels in use in each pixel.
     pub channels: usize,
+    /// One pixel per element, bottom row first.
     pub pixels: Vec<[f32; 4]>,
 }
 

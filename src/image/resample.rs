@@ -7,9 +7,12 @@ use super::WarpMap;
 use super::{EdgeMode, Filter, ImageView, RowsMut, Sample, Sampler};
 use crate::geom::PixelScale;
 
+/// How a warped source is sampled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct ResampleSettings {
+    /// The reconstruction filter.
     pub filter: Filter,
+    /// What lies outside the source's pixels.
     pub edge: EdgeMode,
     /// Whether RGBA sources hold premultiplied colour (OFX's usual state).
     pub premultiplied: bool,

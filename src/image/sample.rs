@@ -89,6 +89,9 @@ pub struct Sampler<'a, T> {
 }
 
 impl<'a, T: Sample> Sampler<'a, T> {
+    /// A sampler of `view` at render scale `scale`; `premultiplied` says whether an RGBA
+    /// source's colour is already times alpha (else colour is weighted by alpha while
+    /// filtering).
     pub fn new(
         view: ImageView<'a, T>,
         scale: PixelScale,
@@ -106,6 +109,7 @@ impl<'a, T: Sample> Sampler<'a, T> {
         }
     }
 
+    /// Components per pixel.
     #[inline]
     pub fn channels(&self) -> usize {
         self.view.channels()
@@ -116,21 +120,25 @@ impl<'a, T: Sample> Sampler<'a, T> {
         self.view
     }
 
+    /// The reconstruction filter.
     #[inline]
     pub fn filter(&self) -> Filter {
         self.filter
     }
 
+    /// The source's pixels.
     #[inline]
     pub fn bounds(&self) -> RectI {
         self.view.bounds()
     }
 
+    /// The render scale the source is at.
     #[inline]
     pub fn scale(&self) -> PixelScale {
         self.scale
     }
 
+    /// What lies outside the source's pixels.
     #[inline]
     pub fn edge(&self) -> EdgeMode {
         self.edge

@@ -3,10 +3,12 @@
 
 use crate::geom::{PixelScale, RectI, Vec2};
 
+/// A reverse map: for each output pixel, the canonical source position it samples.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WarpMap {
     /// Output pixels covered, at `scale`.
     pub window: RectI,
+    /// The render scale of the output pixels.
     pub scale: PixelScale,
     /// Canonical source position per output pixel, rows bottom-up. Empty when
     /// `identity` (then every pixel samples its own centre).
@@ -15,6 +17,7 @@ pub struct WarpMap {
 }
 
 impl WarpMap {
+    /// A map from one position per pixel of `window`, rows bottom-up.
     pub fn new(window: RectI, scale: PixelScale, positions: Vec<[f32; 2]>) -> Self {
         assert_eq!(positions.len(), window.area(), "one position per pixel");
         WarpMap {
@@ -25,6 +28,7 @@ impl WarpMap {
         }
     }
 
+    /// The map of every pixel to its own centre.
     pub fn identity(window: RectI, scale: PixelScale) -> Self {
         WarpMap {
             window,
@@ -34,6 +38,7 @@ impl WarpMap {
         }
     }
 
+    /// True when every pixel samples its own centre.
     #[inline]
     pub fn is_identity(&self) -> bool {
         self.identity
@@ -61,6 +66,7 @@ impl WarpMap {
         Some(&self.positions[start..start + w])
     }
 
+    /// Heap bytes held (for cache budgets).
     pub fn memory_bytes(&self) -> usize {
         self.positions.len() * std::mem::size_of::<[f32; 2]>()
     }

@@ -5,13 +5,20 @@ use crate::choice::Choice;
 /// The warp generator (scene key `method`, the nodes' Method param).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Method {
+    /// Beier-Neely line-pair field warping.
     #[default]
     Field,
+    /// Smythe and Wolberg's two-pass Catmull-Rom mesh warp.
     Mesh,
+    /// Piecewise-affine warping over a Delaunay triangulation.
     Triangles,
+    /// Lee et al.'s thin-plate deformable surfaces, solved by multigrid.
     ThinPlate,
+    /// Lee, Wolberg et al.'s multilevel free-form deformation.
     Mffd,
+    /// The hybrid of MFFD and thin plate (Lee, Wolberg et al.).
     Hybrid,
+    /// Gao and Sederberg's automatic warp by work minimisation.
     Auto,
 }
 

@@ -18,7 +18,9 @@ use crate::warp::thin_plate::ThinPlateSettings;
 /// says and what a node's params set, one struct for both.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MethodSettings {
+    /// Which warp generator.
     pub method: Method,
+    /// Field-warp settings (scene key `field`).
     pub field: FieldSettings,
     /// Mesh method settings (scene key `mesh`).
     pub mesh: MeshSettings,
@@ -28,6 +30,7 @@ pub struct MethodSettings {
     pub thin_plate: ThinPlateSettings,
     /// Settings of `mffd` (and of the hybrid's MFFD steps).
     pub mffd: MffdSettings,
+    /// Settings of `hybrid` (scene key `hybrid`).
     pub hybrid: HybridSettings,
     /// Transition control: the geometry rates move each feature point at its
     /// own pace; the colour rates are the dissolve's (see [`crate::transition`]).
@@ -57,6 +60,7 @@ impl Default for MethodSettings {
 /// method's settings and the inputs of one frame some methods need.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct WarpSettings {
+    /// The method and every method's settings.
     pub settings: MethodSettings,
     /// The mesh pair at this frame (method `mesh`).
     pub meshes: Option<MeshPair>,

@@ -15,10 +15,14 @@ pub use parse::FORMAT;
 /// A feature set at one frame of an image sequence.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Keyframe {
+    /// The frame of the image sequence the features are keyed at.
     pub frame: f64,
+    /// The features at that frame.
     pub features: Vec<Feature>,
 }
 
+/// A morph as a scene file describes it: the features, their keyframes, the meshes and
+/// every setting.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     /// The method and its settings (scene keys `method`, `field`, `mesh`,

@@ -15,6 +15,7 @@ use crate::warp::auto::{AutoSettings, Coefficients, Grid};
 use crate::warp::field::{Evaluation, FieldSettings, LineInterpolation};
 use crate::warp::mesh::{Mesh, MeshPair, MeshSettings, Pass};
 
+/// The value of a scene file's `format` key.
 pub const FORMAT: &str = "morphfx-scene";
 
 #[derive(Deserialize)]

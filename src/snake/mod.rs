@@ -53,6 +53,7 @@ const CLAMPED: f64 = 1e12;
 /// primitive's control points, and which are held still.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Snake {
+    /// The sampled points, in order along the primitive.
     pub points: Vec<Vec2>,
     /// Index in `points` of each control point of the primitive.
     pub controls: Vec<usize>,

@@ -3,6 +3,7 @@
 
 use crate::error::{Error, Result};
 
+/// A piecewise-linear transition curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Curve {
     /// `(t, rate)` keys, strictly increasing in `t`, `(0, 0)` and `(1, 1)`

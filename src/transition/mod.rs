@@ -36,9 +36,12 @@ pub enum Attach {
     At(Vec2),
 }
 
+/// A transition curve and the feature points it applies to.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Attached {
+    /// Which points.
     pub attach: Attach,
+    /// Their rate over progress.
     pub curve: Curve,
 }
 
@@ -57,15 +60,20 @@ impl Default for Propagation {
     }
 }
 
+/// How each point's rate of transition depends on the progress `t` (Lee et al. §4).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum Transition {
     /// Every point at rate `t`.
     #[default]
     Uniform,
+    /// Curves at feature points, spread over the image (Lee et al. §4.1).
     Curves {
+        /// The curves and the points they are attached to.
         curves: Vec<Attached>,
+        /// How the rates spread between the points.
         propagation: Propagation,
     },
+    /// A pattern over the image, no features needed (Lee et al. §4.2).
     Procedural(Procedural),
 }
 
@@ -73,11 +81,14 @@ pub enum Transition {
 /// geometry, as Lee, Wolberg et al. §3 treats them).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TransitionSettings {
+    /// The rates at which feature points move.
     pub geometry: Transition,
+    /// The dissolve's rates; `None`: the geometry's.
     pub colour: Option<Transition>,
 }
 
 impl TransitionSettings {
+    /// The colour transition in effect.
     pub fn colour(&self) -> &Transition {
         self.colour.as_ref().unwrap_or(&self.geometry)
     }
@@ -86,20 +97,29 @@ impl TransitionSettings {
 /// `T0(·; t)` at one instant: the rate of every point of A.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Rates {
+    /// Every point at rate `t`.
     Uniform(f64),
+    /// A procedural pattern over `frame` at progress `t`.
     Procedural {
+        /// The pattern and its spread.
         procedural: Procedural,
+        /// The frame the pattern covers (canonical).
         frame: RectD,
+        /// The progress.
         t: f64,
     },
     /// `t + ΔT(p)`, `ΔT` a B-spline surface.
     Surface {
+        /// The progress.
         t: f64,
+        /// The offset surface `ΔT`.
         delta: Lattice,
     },
     /// `t + ΔT(p)`, `ΔT` a thin plate.
     Plate {
+        /// The progress.
         t: f64,
+        /// The offset `ΔT` at the plate's nodes (in `disp.x`).
         delta: NodeGrid,
     },
 }
@@ -242,12 +262,16 @@ pub fn constraints(
 /// `1 − T0` at the point it comes from, B's by `T1 = T0 ∘ W1` at its point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Weights {
+    /// Output pixels covered.
     pub window: RectI,
+    /// A's weight per pixel, rows bottom-up.
     pub a: Vec<f32>,
+    /// B's weight per pixel, rows bottom-up.
     pub b: Vec<f32>,
 }
 
 impl Weights {
+    /// Heap bytes held (for cache budgets).
     pub fn memory_bytes(&self) -> usize {
         (self.a.len() + self.b.len()) * 4
     }

@@ -15,26 +15,45 @@ use std::f64::consts::TAU;
 use crate::choice::Choice;
 use crate::geom::{RectD, Vec2};
 
+/// A procedural transition's shape: which points go first.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Pattern {
     /// A linear wipe along `angle` (degrees; 0: left to right, 90: bottom to top).
-    Ramp { angle: f64 },
+    Ramp {
+        /// Degrees.
+        angle: f64,
+    },
     /// A sinusoid along the rows (varies with x), `cycles` across the frame.
-    SineRows { cycles: f64 },
+    SineRows {
+        /// Periods across the frame.
+        cycles: f64,
+    },
     /// A sinusoid along the columns (varies with y).
-    SineColumns { cycles: f64 },
+    SineColumns {
+        /// Periods up the frame.
+        cycles: f64,
+    },
     /// Rings around `centre` (canonical; `None`: the frame's centre): the
     /// centre first when `cycles` is 0, else a sinusoid of the radius.
-    Radial { cycles: f64, centre: Option<Vec2> },
+    Radial {
+        /// Periods from the centre to the farthest corner; 0: a plain radial wipe.
+        cycles: f64,
+        /// The rings' centre (canonical); `None`: the frame's centre.
+        centre: Option<Vec2>,
+    },
 }
 
 /// Which pattern, without its numbers: what a scene's `pattern` and the
 /// nodes' Transition param name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PatternKind {
+    /// A linear wipe.
     Ramp,
+    /// A sinusoid varying with x.
     SineRows,
+    /// A sinusoid varying with y.
     SineColumns,
+    /// Rings around a centre.
     Radial,
 }
 
@@ -55,13 +74,16 @@ impl Choice for PatternKind {
     }
 }
 
+/// A procedural transition: a pattern, swept over part of the progress.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Procedural {
+    /// Which points go first.
     pub pattern: Pattern,
     /// The share of the progress over which the pattern sweeps, `[0, 0.99]`.
     pub spread: f64,
 }
 
+/// The largest `spread`: at 1 the first point would finish before the last began.
 pub const MAX_SPREAD: f64 = 0.99;
 
 impl Procedural {

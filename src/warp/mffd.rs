@@ -19,6 +19,7 @@ use wide::f64x4;
 /// Theorem 1's bound on a control displacement, in lattice spacings.
 pub const ONE_TO_ONE_BOUND: f64 = 0.48;
 
+/// Multilevel free-form deformation settings (scene key `mffd`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MffdSettings {
     /// Cells of the coarsest lattice across the longer side of the frame
@@ -58,7 +59,9 @@ const MAX_STEPS: usize = 96;
 /// One FFD: `p ↦ p + (dx(p), dy(p))`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Deformation {
+    /// Displacement in x.
     pub dx: Lattice,
+    /// Displacement in y.
     pub dy: Lattice,
     /// The layout [`Deformation::apply`] reads; `None` when `dx` and `dy`
     /// differ in geometry (then both lattices are evaluated separately).
@@ -120,12 +123,14 @@ impl Packed {
 }
 
 impl Deformation {
+    /// The deformation by `dx` and `dy`.
     pub fn new(dx: Lattice, dy: Lattice) -> Self {
         let same = (dx.origin, dx.h, dx.nx, dx.ny) == (dy.origin, dy.h, dy.nx, dy.ny);
         let packed = same.then(|| Packed::new(&dx, &dy));
         Deformation { dx, dy, packed }
     }
 
+    /// `p` moved by the deformation.
     #[inline]
     pub fn apply(&self, p: Vec2) -> Vec2 {
         let Some(packed) = &self.packed else {
@@ -182,6 +187,7 @@ impl Deformation {
 /// A solved MFFD: its steps (applied first to last) and what it reached.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mffd {
+    /// The deformations, applied first to last.
     pub steps: Vec<Deformation>,
     /// Largest distance from a constraint's target after the last step.
     pub error: f64,
@@ -296,6 +302,7 @@ fn ffd_step(at: &[Vec2], targets: &[Vec2], frame: RectD, h: f64, truncate: bool)
 /// bilinear between them.
 #[derive(Debug, Clone)]
 pub struct MffdWarp {
+    /// The solved deformation.
     pub mffd: Mffd,
 }
 

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
 
+/// A reverse map: where each output point samples its source.
 pub trait Warp: Send + Sync {
     /// Where output position `p` samples the source (canonical coordinates).
     fn map(&self, p: Vec2) -> Vec2;

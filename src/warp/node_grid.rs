@@ -7,13 +7,16 @@ use rayon::prelude::*;
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
 
+/// Displacements at the nodes of a regular grid, bilinear between them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeGrid {
     /// Canonical position of node (0, 0).
     pub origin: Vec2,
     /// Canonical spacing of the nodes in x and y.
     pub step: Vec2,
+    /// Nodes in x.
     pub nx: usize,
+    /// Nodes in y.
     pub ny: usize,
     /// Displacement (source − position) per node, row-major.
     pub disp: Vec<Vec2>,
@@ -33,6 +36,7 @@ impl NodeGrid {
         }
     }
 
+    /// Canonical position of node `(i, j)`.
     #[inline]
     pub fn node(&self, i: usize, j: usize) -> Vec2 {
         Vec2::new(

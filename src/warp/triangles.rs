@@ -184,6 +184,7 @@ impl TriangleWarp {
         self.tris.len()
     }
 
+    /// True when there are no triangles.
     pub fn is_empty(&self) -> bool {
         self.tris.is_empty()
     }

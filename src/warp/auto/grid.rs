@@ -10,6 +10,7 @@ use crate::geom::Vec2;
 /// plate needs: a 4K plate's quads would be 4 pixels wide).
 pub const MAX_LEVEL: u32 = 10;
 
+/// The control points of a `2^level × 2^level` quad grid over the unit square.
 #[derive(Clone, PartialEq)]
 pub struct Grid {
     level: u32,
@@ -27,11 +28,13 @@ impl std::fmt::Debug for Grid {
 /// vertices slide along their edge).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Freedom {
+    /// A corner: does not move.
     Fixed,
     /// On the bottom or top edge: x moves.
     AlongX,
     /// On the left or right edge: y moves.
     AlongY,
+    /// An inner point: moves in x and y.
     Free,
 }
 
@@ -73,6 +76,7 @@ impl Grid {
         Ok(g)
     }
 
+    /// Quads per side are `2^level`.
     pub fn level(&self) -> u32 {
         self.level
     }
@@ -82,20 +86,24 @@ impl Grid {
         1 << self.level
     }
 
+    /// Every point, row `k` major.
     pub fn points(&self) -> &[Vec2] {
         &self.pts
     }
 
+    /// The index in [`Grid::points`] of point `(j, k)`.
     #[inline]
     pub fn index(&self, j: usize, k: usize) -> usize {
         k * (self.n() + 1) + j
     }
 
+    /// Point `(j, k)`.
     #[inline]
     pub fn at(&self, j: usize, k: usize) -> Vec2 {
         self.pts[self.index(j, k)]
     }
 
+    /// Moves point `(j, k)` to `p`.
     #[inline]
     pub fn set(&mut self, j: usize, k: usize, p: Vec2) {
         let i = self.index(j, k);
@@ -113,6 +121,7 @@ impl Grid {
         ]
     }
 
+    /// How point `(j, k)` may move.
     pub fn freedom(&self, j: usize, k: usize) -> Freedom {
         let n = self.n();
         let (xe, ye) = (j == 0 || j == n, k == 0 || k == n);

@@ -31,6 +31,7 @@ pub struct AutoSettings {
     /// Deepest level `i_max` (`2^i` patches per side); `None`: quads of
     /// about 4 pixels on the plate's longer side (6 at 256², 8 at 1080p).
     pub levels: Option<u32>,
+    /// The work's weights.
     pub coefficients: Coefficients,
     /// Start each frame of a sequence from the previous frame's warp.
     pub warm_start: bool,
@@ -87,13 +88,18 @@ pub enum Start<'a> {
 /// The work at the end of one level (level 0: the start), as the paper's table.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LevelWork {
+    /// The level (quads per side `2^level`).
     pub level: u32,
+    /// The work there.
     pub work: Work,
 }
 
+/// A solved warp grid and the work at each level.
 #[derive(Debug, Clone)]
 pub struct Solution {
+    /// The finest grid: A's lattice points on B (unit square).
     pub grid: Grid,
+    /// The work at the end of each level.
     pub table: Vec<LevelWork>,
 }
 
@@ -202,14 +208,18 @@ pub fn table_text(table: &[LevelWork]) -> String {
 /// lattice corresponds to the grid's points on B.
 #[derive(Clone)]
 pub struct Correspondence {
+    /// A's lattice points' places on B (unit square).
     pub grid: Grid,
+    /// A's frame (canonical).
     pub a_frame: RectD,
+    /// B's frame (canonical).
     pub b_frame: RectD,
     /// A digest of all of the above, so caches can key on it cheaply.
     id: u64,
 }
 
 impl Correspondence {
+    /// A solved grid placed on the two frames.
     pub fn new(grid: Grid, a_frame: RectD, b_frame: RectD) -> Self {
         let mut h = std::collections::hash_map::DefaultHasher::new();
         for p in grid.points() {

@@ -18,6 +18,8 @@ struct Buckets {
     lists: Vec<Vec<u32>>,
 }
 
+/// The reverse map of a quad grid warp: each output point found in its quad and mapped by
+/// the quad's bilinear patch.
 pub struct QuadWarp {
     n: usize,
     /// The in-between positions (canonical pixels).

@@ -18,12 +18,15 @@ use super::grid::bilinear;
 /// An RGB picture for the work: colours as `[r, g, b, 0]`, rows bottom-up.
 #[derive(Clone)]
 pub struct WorkImage {
+    /// Pixels across.
     pub width: usize,
+    /// Pixels up.
     pub height: usize,
     pixels: Vec<[f32; 4]>,
 }
 
 impl WorkImage {
+    /// A picture whose pixel `(i, j)` is `f(i, j)`.
     pub fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> [f32; 3]) -> Self {
         let mut pixels = Vec::with_capacity(width * height);
         for j in 0..height {
@@ -132,9 +135,13 @@ impl WorkImage {
 /// Work coefficients `c_c`, `c_s`, `c_a` of eq. (5) and the anchor weight.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Coefficients {
+    /// `c_c`: weight of colour difference.
     pub colour: f64,
+    /// `c_s`: weight of stretching.
     pub stretch: f64,
+    /// `c_a`: weight of angle change.
     pub angle: f64,
+    /// Weight of the anchor penalty.
     pub anchor: f64,
 }
 
@@ -155,13 +162,18 @@ impl Default for Coefficients {
 /// The weighted work of one quad (or, summed, of a warp), by kind.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Work {
+    /// Colour difference.
     pub colour: f64,
+    /// Stretching.
     pub stretch: f64,
+    /// Angle change.
     pub angle: f64,
+    /// Anchor penalty.
     pub anchor: f64,
 }
 
 impl Work {
+    /// The sum of all four kinds.
     #[inline]
     pub fn total(&self) -> f64 {
         self.colour + self.stretch + self.angle + self.anchor
@@ -190,7 +202,9 @@ impl std::iter::Sum for Work {
 /// to `b` on B.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Anchor {
+    /// Position on A.
     pub a: Vec2,
+    /// Position on B.
     pub b: Vec2,
 }
 
@@ -225,6 +239,8 @@ pub struct Pricer<'a> {
 pub const ANCHOR_FLOOR_PX: f64 = 2.0;
 
 impl<'a> Pricer<'a> {
+    /// A pricer of level `level`'s quads between `a` and `b`, with `anchors` and weights
+    /// `c`.
     pub fn new(
         a: &'a WorkImage,
         b: &'a WorkImage,

@@ -8,7 +8,9 @@ use crate::geom::Vec2;
 /// source image (`src`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinePair {
+    /// The segment in the output.
     pub dst: (Vec2, Vec2),
+    /// The segment in the source image.
     pub src: (Vec2, Vec2),
 }
 

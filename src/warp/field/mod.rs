@@ -42,10 +42,16 @@ pub enum Evaluation {
     Exact,
     /// A coarse grid refined where bilinear interpolation would err by more
     /// than `tolerance` pixels ([`split`]).
-    Adaptive { tolerance: f64 },
+    /// A coarse grid refined until bilinear interpolation errs by less than `tolerance`
+    /// pixels.
+    Adaptive {
+        /// Largest interpolation error allowed (output px).
+        tolerance: f64,
+    },
 }
 
 impl Evaluation {
+    /// The adaptive evaluation's default tolerance (px).
     pub const DEFAULT_TOLERANCE: f64 = 0.05;
 }
 
@@ -57,6 +63,7 @@ impl Default for Evaluation {
     }
 }
 
+/// Beier-Neely field warp settings (scene key `field`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FieldSettings {
     /// Eq. (4) `a`: barely above zero pins pixels on a line exactly to it.
@@ -65,7 +72,9 @@ pub struct FieldSettings {
     pub b: f64,
     /// Eq. (4) `p`: how much longer lines outweigh shorter ones.
     pub p: f64,
+    /// How the in-between lines are made from A's and B's.
     pub interpolation: LineInterpolation,
+    /// Exact or adaptive evaluation.
     pub evaluation: Evaluation,
     /// Line segments per Catmull-Rom span when a curve feature becomes lines.
     pub curve_samples: usize,
@@ -96,6 +105,7 @@ pub struct FieldWarp {
 }
 
 impl FieldWarp {
+    /// The warp defined by `pairs` with `settings`' weights.
     pub fn new(pairs: Vec<LinePair>, settings: &FieldSettings) -> Self {
         let weight = Weight::new(settings.a, settings.b, settings.p);
         let identity = pairs.iter().all(|l| l.dst == l.src);
@@ -123,6 +133,7 @@ impl FieldWarp {
         )
     }
 
+    /// The line pairs.
     pub fn pairs(&self) -> &[LinePair] {
         &self.pairs
     }

@@ -1,13 +1,18 @@
 //! Beier-Neely eq. (4): `weight = (length^p / (a + dist))^b`.
 
+/// Beier-Neely eq. (4)'s constants.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Weight {
+    /// Added to the distance: barely above zero pins pixels on a line to it.
     pub a: f64,
+    /// How fast a line's influence falls off with distance.
     pub b: f64,
+    /// How much longer lines outweigh shorter ones.
     pub p: f64,
 }
 
 impl Weight {
+    /// The weight with constants `a`, `b`, `p`.
     pub fn new(a: f64, b: f64, p: f64) -> Self {
         Weight { a, b, p }
     }
@@ -34,12 +39,18 @@ impl Weight {
     }
 }
 
+/// The exponent `b`, with the common values named.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Exponent {
+    /// `b = 0`: every line weighs one.
     Zero,
+    /// `b = 0.5`: a square root.
     Half,
+    /// `b = 1`.
     One,
+    /// `b = 2`: a square.
     Two,
+    /// Any other `b`.
     General(f32),
 }
 

@@ -69,18 +69,22 @@ impl Mesh {
         Mesh::new(rows, cols, nodes)
     }
 
+    /// Node rows.
     #[inline]
     pub fn rows(&self) -> usize {
         self.rows
     }
+    /// Node columns.
     #[inline]
     pub fn cols(&self) -> usize {
         self.cols
     }
+    /// Node at row `r`, column `c`.
     #[inline]
     pub fn node(&self, r: usize, c: usize) -> Vec2 {
         self.nodes[r * self.cols + c]
     }
+    /// Every node, row-major, bottom row first.
     pub fn nodes(&self) -> &[Vec2] {
         &self.nodes
     }
@@ -190,13 +194,16 @@ impl Choice for Pass {
 /// Mesh method settings (scene key `mesh`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct MeshSettings {
+    /// One pass or two.
     pub pass: Pass,
 }
 
 /// The mesh on A and the mesh on B, node for node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshPair {
+    /// The mesh on A.
     pub a: Mesh,
+    /// The mesh on B, node for node.
     pub b: Mesh,
 }
 
@@ -233,6 +240,7 @@ impl MeshPair {
         Ok(MeshPair { a, b })
     }
 
+    /// The mesh on `side`.
     pub fn side(&self, side: Side) -> &Mesh {
         match side {
             Side::A => &self.a,

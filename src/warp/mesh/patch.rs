@@ -216,6 +216,7 @@ pub struct MeshWarp {
 }
 
 impl MeshWarp {
+    /// The reverse map from mesh `to` (output) to mesh `from` (source).
     pub fn new(from: &Mesh, to: &Mesh) -> MeshWarp {
         MeshWarp {
             to: Surface::new(to),

@@ -14,6 +14,7 @@ use crate::geom::{PixelScale, RectD, RectI, Vec2};
 use crate::image::WarpMap;
 use multigrid::{Hierarchy, Report};
 
+/// Thin-plate settings (scene key `thin-plate`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ThinPlateSettings {
     /// Spring constant `α` (px⁻²): how tightly the plate meets the constraints.
@@ -25,6 +26,7 @@ pub struct ThinPlateSettings {
     pub cell: f64,
     /// Stop when an iteration moves no node by more than this (px).
     pub tolerance: f64,
+    /// Most multigrid cycles per solve.
     pub max_cycles: usize,
 }
 
@@ -43,8 +45,11 @@ impl Default for ThinPlateSettings {
 /// Both displacement surfaces on their node grid, and how the solve went.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ThinPlate {
+    /// The nodes and their displacements.
     pub nodes: NodeGrid,
+    /// How the x solve went.
     pub report_x: Report,
+    /// How the y solve went.
     pub report_y: Report,
 }
 
@@ -130,11 +135,13 @@ fn layout(frame: RectD, pairs: &[(Vec2, Vec2)], cell: f64) -> (Vec2, usize, usiz
 /// The reverse map of a solved plate pair.
 #[derive(Debug, Clone)]
 pub struct ThinPlateWarp {
+    /// The solved plates.
     pub plate: ThinPlate,
     identity: bool,
 }
 
 impl ThinPlateWarp {
+    /// The reverse map of `plate`.
     pub fn new(plate: ThinPlate) -> Self {
         let identity = plate.nodes.disp.iter().all(|d| *d == Vec2::ZERO);
         ThinPlateWarp { plate, identity }

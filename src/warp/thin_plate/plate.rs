@@ -17,18 +17,26 @@
 /// the height it pulls toward.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spring {
+    /// The four nodes of the spring's cell.
     pub nodes: [usize; 4],
+    /// Their bilinear weights at the attachment.
     pub weights: [f64; 4],
+    /// The height the spring pulls toward.
     pub z: f64,
 }
 
+/// A thin plate on a node grid: its bending, glue and springs.
 #[derive(Debug, Clone)]
 pub struct Plate {
+    /// Nodes in x.
     pub nx: usize,
+    /// Nodes in y.
     pub ny: usize,
     /// Node spacing (canonical px).
     pub h: f64,
+    /// Spring constant `α`.
     pub alpha: f64,
+    /// Glue `β`.
     pub beta: f64,
     /// Attachments (positions) of the springs; heights vary per surface.
     pub springs: Vec<Spring>,

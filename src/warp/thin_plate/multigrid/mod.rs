@@ -53,6 +53,7 @@ use transfer::Transfer;
 pub struct Hierarchy {
     /// The finest plate (its springs give the right-hand sides).
     pub plate: Plate,
+    /// Each level's operator, finest first.
     pub levels: Vec<Stencil>,
     /// `transfers[l]`: between level `l` and `l + 1`.
     transfers: Vec<Transfer>,

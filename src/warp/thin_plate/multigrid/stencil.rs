@@ -14,7 +14,9 @@ use super::galerkin::{children, parents, window_sum, Classes};
 /// sweeps run from cache instead of streaming memory.
 #[derive(Debug, Clone)]
 pub struct Stencil {
+    /// Nodes in x.
     pub nx: usize,
+    /// Nodes in y.
     pub ny: usize,
     /// Stencil width: 5 or 7.
     pub(super) side: usize,
@@ -200,6 +202,7 @@ impl Stencil {
         }
     }
 
+    /// `b − A f`.
     pub fn residual(&self, f: &[f64], b: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; f.len()];
         self.apply(f, &mut r);
