@@ -165,20 +165,7 @@ fn run(cli: Cli) -> Result<(), HostError> {
     // on the plates and needs no bundle.
     let bundle_path = || find_bundle(cli.bundle.as_deref());
     match cli.command {
-        Command::Plugins => {
-            let bundle = Bundle::load(&bundle_path()?)?;
-            println!("bundle: {}", bundle.binary.display());
-            for p in &bundle.plugins {
-                let served_by = p
-                    .served_by
-                    .as_ref()
-                    .and_then(|b| b.file_name())
-                    .map(|b| b.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                println!("{}\t{}.{}\t{served_by}", p.id, p.version.0, p.version.1);
-            }
-            Ok(())
-        }
+        Command::Plugins => list_plugins(&bundle_path()?),
         Command::Morph {
             common,
             a,
@@ -187,34 +174,7 @@ fn run(cli: Cli) -> Result<(), HostError> {
             stmap_b,
             view,
             context,
-        } => {
-            let ctx = match context.as_str() {
-                "general" => "OfxImageEffectContextGeneral",
-                "transition" => "OfxImageEffectContextTransition",
-                other => {
-                    return Err(HostError::bad(format!(
-                        "--context {other}: expected general or transition"
-                    )))
-                }
-            };
-            let (ca, cb) = if context == "transition" {
-                ("SourceFrom", "SourceTo")
-            } else {
-                ("SourceA", "SourceB")
-            };
-            let job = Job {
-                plugin: MORPH_ID,
-                context: ctx,
-                sources: vec![(ca.to_owned(), a), (cb.to_owned(), b)],
-                view,
-                extra: [("stmap-a", stmap_a), ("stmap-b", stmap_b)]
-                    .into_iter()
-                    .filter_map(|(v, o)| o.map(|o| (v.to_owned(), o)))
-                    .collect(),
-                common,
-            };
-            job.run(&bundle_path()?)
-        }
+        } => morph_job(common, a, b, [stmap_a, stmap_b], view, &context)?.run(&bundle_path()?),
         Command::Warp {
             common,
             input,
@@ -264,6 +224,56 @@ fn run(cli: Cli) -> Result<(), HostError> {
             height,
         } => bench(&bundle_path()?, &output, frames, (width, height)),
     }
+}
+
+/// `morphfx plugins`: each plugin of the bundle with its version.
+fn list_plugins(bundle_path: &Path) -> Result<(), HostError> {
+    let bundle = Bundle::load(bundle_path)?;
+    println!("bundle: {}", bundle.binary.display());
+    for p in &bundle.plugins {
+        let served_by = p
+            .served_by
+            .as_ref()
+            .and_then(|b| b.file_name())
+            .map(|b| b.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        println!("{}\t{}.{}\t{served_by}", p.id, p.version.0, p.version.1);
+    }
+    Ok(())
+}
+
+/// `morphfx morph`: the morph node in the general or transition context.
+fn morph_job(
+    common: Common,
+    a: String,
+    b: String,
+    [stmap_a, stmap_b]: [Option<String>; 2],
+    view: String,
+    context: &str,
+) -> Result<Job, HostError> {
+    let (ctx, [ca, cb]) = match context {
+        "general" => ("OfxImageEffectContextGeneral", ["SourceA", "SourceB"]),
+        "transition" => (
+            "OfxImageEffectContextTransition",
+            ["SourceFrom", "SourceTo"],
+        ),
+        other => {
+            return Err(HostError::bad(format!(
+                "--context {other}: expected general or transition"
+            )))
+        }
+    };
+    Ok(Job {
+        plugin: MORPH_ID,
+        context: ctx,
+        sources: vec![(ca.to_owned(), a), (cb.to_owned(), b)],
+        view,
+        extra: [("stmap-a", stmap_a), ("stmap-b", stmap_b)]
+            .into_iter()
+            .filter_map(|(v, o)| o.map(|o| (v.to_owned(), o)))
+            .collect(),
+        common,
+    })
 }
 
 fn find_bundle(given: Option<&Path>) -> Result<PathBuf, HostError> {

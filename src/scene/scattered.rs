@@ -169,15 +169,6 @@ fn mffd(raw: RawMffd) -> Result<MffdSettings> {
 }
 
 fn transition(raw: RawTransition, at: &str, features: &[Feature]) -> Result<Transition> {
-    let refuse = |keys: &[(&str, bool)]| -> Result<()> {
-        match keys.iter().find(|(_, present)| *present) {
-            Some((k, _)) => Err(Error::scene(
-                format!("{at}.{k}"),
-                format!("does not apply to type \"{}\"", raw.kind),
-            )),
-            None => Ok(()),
-        }
-    };
     let curve_keys = [
         ("curves", raw.curves.is_some()),
         ("surface", raw.surface.is_some()),
@@ -192,6 +183,7 @@ fn transition(raw: RawTransition, at: &str, features: &[Feature]) -> Result<Tran
         ("cycles", raw.cycles.is_some()),
         ("centre", raw.centre.is_some()),
     ];
+    let refuse = |keys: &[(&str, bool)]| refuse_keys(keys, at, &raw.kind);
     match raw.kind.as_str() {
         "uniform" => {
             refuse(&curve_keys)?;
@@ -200,97 +192,109 @@ fn transition(raw: RawTransition, at: &str, features: &[Feature]) -> Result<Tran
         }
         "curves" => {
             refuse(&pattern_keys)?;
-            let list = raw.curves.ok_or_else(|| {
-                Error::scene(
-                    format!("{at}.curves"),
-                    "type \"curves\" needs a list of curves",
-                )
-            })?;
-            let curves = list
-                .into_iter()
-                .enumerate()
-                .map(|(k, c)| curve(c, &format!("{at}.curves[{k}]"), features))
-                .collect::<Result<Vec<_>>>()?;
-            let d = MbaSettings::default();
-            let propagation = match raw.surface.as_deref() {
-                None | Some("bspline") => Propagation::BSpline(MbaSettings {
-                    coarsest: in_range(
-                        raw.coarsest,
-                        d.coarsest,
-                        1..=64,
-                        &format!("{at}.coarsest"),
-                    )?,
-                    threshold: positive(
-                        raw.threshold,
-                        d.threshold,
-                        1.0,
-                        &format!("{at}.threshold"),
-                    )?,
-                    finest: in_range(raw.finest, d.finest, 0.5..=256.0, &format!("{at}.finest"))?,
-                }),
-                Some("thin-plate") => {
-                    refuse(&curve_keys[2..])?;
-                    Propagation::ThinPlate(ThinPlateSettings {
-                        cell: 8.0,
-                        ..ThinPlateSettings::default()
-                    })
-                }
-                Some(other) => {
-                    return Err(Error::scene(
-                        format!("{at}.surface"),
-                        format!("unknown surface \"{other}\" (bspline or thin-plate)"),
-                    ))
-                }
-            };
-            Ok(Transition::Curves {
-                curves,
-                propagation,
-            })
+            if raw.surface.as_deref() == Some("thin-plate") {
+                // The plate has no lattice to size.
+                refuse(&curve_keys[2..])?;
+            }
+            curves_transition(raw, at, features)
         }
         "procedural" => {
             refuse(&curve_keys)?;
-            let cycles = in_range(raw.cycles, 2.0, 0.0..=100.0, &format!("{at}.cycles"))?;
-            let angle = in_range(raw.angle, 0.0, -360.0..=360.0, &format!("{at}.angle"))?;
-            let name = raw.pattern.as_deref().unwrap_or("ramp");
-            let kind = PatternKind::parse(name).ok_or_else(|| {
-                Error::scene(
-                    format!("{at}.pattern"),
-                    format!(
-                        "unknown pattern \"{name}\" ({})",
-                        PatternKind::names().join(", ")
-                    ),
-                )
-            })?;
-            let pattern = match kind {
-                PatternKind::Ramp => Pattern::Ramp { angle },
-                PatternKind::SineRows => Pattern::SineRows { cycles },
-                PatternKind::SineColumns => Pattern::SineColumns { cycles },
-                PatternKind::Radial => Pattern::Radial {
-                    cycles: in_range(raw.cycles, 0.0, 0.0..=100.0, &format!("{at}.cycles"))?,
-                    centre: raw.centre.map(Vec2::from),
-                },
-            };
-            if let Some(c) = raw.centre {
-                if !matches!(pattern, Pattern::Radial { .. }) {
-                    return Err(Error::scene(
-                        format!("{at}.centre"),
-                        "only the radial pattern has a centre",
-                    ));
-                }
-                if !(c[0].is_finite() && c[1].is_finite()) {
-                    return Err(Error::scene(format!("{at}.centre"), "not a finite number"));
-                }
-            }
-            Ok(Transition::Procedural(Procedural {
-                pattern,
-                spread: in_range(raw.spread, 0.5, 0.0..=MAX_SPREAD, &format!("{at}.spread"))?,
-            }))
+            procedural_transition(raw, at)
         }
         other => Err(Error::scene(
             format!("{at}.type"),
             format!("unknown transition type \"{other}\" (uniform, curves, procedural)"),
         )),
     }
+}
+
+/// Refuses the first present key of `keys`: it belongs to another type.
+fn refuse_keys(keys: &[(&str, bool)], at: &str, kind: &str) -> Result<()> {
+    match keys.iter().find(|(_, present)| *present) {
+        Some((k, _)) => Err(Error::scene(
+            format!("{at}.{k}"),
+            format!("does not apply to type \"{kind}\""),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Type `curves`: transition curves at features, spread by a surface.
+fn curves_transition(raw: RawTransition, at: &str, features: &[Feature]) -> Result<Transition> {
+    let list = raw.curves.ok_or_else(|| {
+        Error::scene(
+            format!("{at}.curves"),
+            "type \"curves\" needs a list of curves",
+        )
+    })?;
+    let curves = list
+        .into_iter()
+        .enumerate()
+        .map(|(k, c)| curve(c, &format!("{at}.curves[{k}]"), features))
+        .collect::<Result<Vec<_>>>()?;
+    let d = MbaSettings::default();
+    let propagation = match raw.surface.as_deref() {
+        None | Some("bspline") => Propagation::BSpline(MbaSettings {
+            coarsest: in_range(raw.coarsest, d.coarsest, 1..=64, &format!("{at}.coarsest"))?,
+            threshold: positive(raw.threshold, d.threshold, 1.0, &format!("{at}.threshold"))?,
+            finest: in_range(raw.finest, d.finest, 0.5..=256.0, &format!("{at}.finest"))?,
+        }),
+        Some("thin-plate") => Propagation::ThinPlate(ThinPlateSettings {
+            cell: 8.0,
+            ..ThinPlateSettings::default()
+        }),
+        Some(other) => {
+            return Err(Error::scene(
+                format!("{at}.surface"),
+                format!("unknown surface \"{other}\" (bspline or thin-plate)"),
+            ))
+        }
+    };
+    Ok(Transition::Curves {
+        curves,
+        propagation,
+    })
+}
+
+/// Type `procedural`: a pattern over the frame.
+fn procedural_transition(raw: RawTransition, at: &str) -> Result<Transition> {
+    let cycles = in_range(raw.cycles, 2.0, 0.0..=100.0, &format!("{at}.cycles"))?;
+    let angle = in_range(raw.angle, 0.0, -360.0..=360.0, &format!("{at}.angle"))?;
+    let name = raw.pattern.as_deref().unwrap_or("ramp");
+    let kind = PatternKind::parse(name).ok_or_else(|| {
+        Error::scene(
+            format!("{at}.pattern"),
+            format!(
+                "unknown pattern \"{name}\" ({})",
+                PatternKind::names().join(", ")
+            ),
+        )
+    })?;
+    let pattern = match kind {
+        PatternKind::Ramp => Pattern::Ramp { angle },
+        PatternKind::SineRows => Pattern::SineRows { cycles },
+        PatternKind::SineColumns => Pattern::SineColumns { cycles },
+        PatternKind::Radial => Pattern::Radial {
+            cycles: in_range(raw.cycles, 0.0, 0.0..=100.0, &format!("{at}.cycles"))?,
+            centre: raw.centre.map(Vec2::from),
+        },
+    };
+    if let Some(c) = raw.centre {
+        if !matches!(pattern, Pattern::Radial { .. }) {
+            return Err(Error::scene(
+                format!("{at}.centre"),
+                "only the radial pattern has a centre",
+            ));
+        }
+        if !(c[0].is_finite() && c[1].is_finite()) {
+            return Err(Error::scene(format!("{at}.centre"), "not a finite number"));
+        }
+    }
+    Ok(Transition::Procedural(Procedural {
+        pattern,
+        spread: in_range(raw.spread, 0.5, 0.0..=MAX_SPREAD, &format!("{at}.spread"))?,
+    }))
 }
 
 fn curve(raw: RawCurve, at: &str, features: &[Feature]) -> Result<Attached> {

@@ -173,6 +173,141 @@ pub struct Bundle {
     _lib: libloading::Library,
 }
 
+/// OK and "reply default" are both success for an action.
+fn accept(st: OfxStatus, what: &str, effect: &Effect) -> Result<(), HostError> {
+    if st == kOfxStatOK || st == kOfxStatReplyDefault {
+        Ok(())
+    } else {
+        Err(failure(st, what, Some(effect)))
+    }
+}
+
+/// A new instance of `descriptor` in `context`: its params and clips copied
+/// from the descriptor, the clips unconnected until a job connects them.
+fn instance_effect(descriptor: &Effect, context: &str) -> Box<Effect> {
+    let effect = Effect::new();
+    for (k, v) in [
+        (kOfxPropType, "OfxTypeImageEffectInstance"),
+        (kOfxImageEffectPropContext, context),
+    ] {
+        effect.props.set_str(k, v);
+    }
+    effect
+        .props
+        .set_double(kOfxImageEffectPropFrameRate, &[24.0]);
+    effect
+        .props
+        .set_double(kOfxImageEffectPropProjectPixelAspectRatio, &[1.0]);
+    effect
+        .props
+        .set_ptr(kOfxPropInstanceData, std::ptr::null_mut());
+    let desc_params = params::ParamSet::instance_of(&descriptor.params);
+    *effect
+        .params
+        .params
+        .lock()
+        .unwrap_or_else(|e| e.into_inner()) =
+        std::mem::take(&mut *desc_params.params.lock().unwrap_or_else(|e| e.into_inner()));
+    for name in descriptor.clip_names() {
+        let desc_clip = descriptor.clip(&name).expect("listed");
+        let clip = effect.add_clip(&name, desc_clip.props.clone_values());
+        clip.props.set_int(kOfxImageClipPropConnected, &[0]);
+        clip.props
+            .set_str(kOfxImageClipPropFieldOrder, "OfxImageFieldNone");
+        clip.props.set_double(kOfxImagePropPixelAspectRatio, &[1.0]);
+        clip.props.set_double(kOfxImageEffectPropFrameRate, &[24.0]);
+    }
+    effect
+}
+
+/// What our host says it is and supports (the host descriptor's properties).
+fn host_properties() -> Box<PropertySet> {
+    let host_props = Box::new(PropertySet::new());
+    host_props.set_str(kOfxPropName, "net.morphfx.harness");
+    host_props.set_str(kOfxPropLabel, "morphfx harness");
+    host_props.set_int(kOfxImageEffectHostPropIsBackground, &[1]);
+    host_props.set_int(kOfxImageEffectPropSupportsOverlays, &[0]);
+    host_props.set_int(kOfxImageEffectPropSupportsMultiResolution, &[1]);
+    host_props.set_int(kOfxImageEffectPropSupportsTiles, &[1]);
+    host_props.set_int(kOfxImageEffectPropTemporalClipAccess, &[1]);
+    host_props.set_strs(
+        kOfxImageEffectPropSupportedComponents,
+        &[
+            "OfxImageComponentRGBA",
+            "OfxImageComponentRGB",
+            "OfxImageComponentAlpha",
+        ],
+    );
+    host_props.set_strs(
+        kOfxImageEffectPropSupportedContexts,
+        &[
+            "OfxImageEffectContextGeneral",
+            "OfxImageEffectContextFilter",
+            "OfxImageEffectContextTransition",
+        ],
+    );
+    host_props.set_strs(
+        kOfxImageEffectPropSupportedPixelDepths,
+        &["OfxBitDepthByte", "OfxBitDepthShort", "OfxBitDepthFloat"],
+    );
+    host_props.set_int(kOfxImageEffectPropSupportsMultipleClipDepths, &[0]);
+    host_props.set_int(kOfxImageEffectPropSupportsMultipleClipPARs, &[0]);
+    host_props.set_int(kOfxParamHostPropSupportsStringAnimation, &[0]);
+    host_props.set_int(kOfxParamHostPropMaxParameters, &[-1]);
+    host_props
+}
+
+/// Hands the bundle our host and lists its plugins.
+///
+/// # Safety
+/// `lib` must be an OFX bundle (its `OfxSetHost`, `OfxGetNumberOfPlugins` and
+/// `OfxGetPlugin` have the OFX signatures), and `lib` and `host` must outlive
+/// every plugin pointer returned.
+unsafe fn plugins_of(
+    lib: &libloading::Library,
+    host: &OfxHost,
+    binary: &Path,
+) -> Result<Vec<PluginInfo>, HostError> {
+    // SAFETY: the caller vouches for the symbols' signatures and lifetimes.
+    unsafe {
+        if let Ok(set_host) =
+            lib.get::<unsafe extern "C" fn(*const OfxHost) -> OfxStatus>(b"OfxSetHost\0")
+        {
+            let st = set_host(host);
+            if st != kOfxStatOK {
+                return Err(HostError::failed(format!(
+                    "OfxSetHost failed with status {st}"
+                )));
+            }
+        }
+        let count = lib
+            .get::<unsafe extern "C" fn() -> c_int>(b"OfxGetNumberOfPlugins\0")
+            .map_err(|e| HostError::bad(format!("{}: not an OFX bundle: {e}", binary.display())))?;
+        let get = lib
+            .get::<unsafe extern "C" fn(c_int) -> *mut OfxPlugin>(b"OfxGetPlugin\0")
+            .map_err(|e| HostError::bad(format!("{}: not an OFX bundle: {e}", binary.display())))?;
+        let mut plugins = Vec::new();
+        for i in 0..count() {
+            let p = get(i);
+            let Some(plugin) = p.as_ref() else { continue };
+            if let Some(set_host) = plugin.setHost {
+                set_host(host as *const OfxHost as *mut OfxHost);
+            }
+            plugins.push(PluginInfo {
+                served_by: plugin
+                    .mainEntry
+                    .and_then(|f| object_holding(f as *const c_void)),
+                id: CStr::from_ptr(plugin.pluginIdentifier)
+                    .to_string_lossy()
+                    .into_owned(),
+                version: (plugin.pluginVersionMajor, plugin.pluginVersionMinor),
+                plugin: p,
+            });
+        }
+        Ok(plugins)
+    }
+}
+
 /// The binary inside a bundle folder, or the path itself if it is a file.
 pub fn bundle_binary(path: &Path) -> PathBuf {
     if path.is_dir() {
@@ -201,86 +336,15 @@ impl Bundle {
         // is such a library by contract, and we load only the path we were given.
         let lib = unsafe { libloading::Library::new(&binary) }
             .map_err(|e| HostError::bad(format!("plugin bundle {}: {e}", binary.display())))?;
-        let host_props = Box::new(PropertySet::new());
-        host_props.set_str(kOfxPropName, "net.morphfx.harness");
-        host_props.set_str(kOfxPropLabel, "morphfx harness");
-        host_props.set_int(kOfxImageEffectHostPropIsBackground, &[1]);
-        host_props.set_int(kOfxImageEffectPropSupportsOverlays, &[0]);
-        host_props.set_int(kOfxImageEffectPropSupportsMultiResolution, &[1]);
-        host_props.set_int(kOfxImageEffectPropSupportsTiles, &[1]);
-        host_props.set_int(kOfxImageEffectPropTemporalClipAccess, &[1]);
-        host_props.set_strs(
-            kOfxImageEffectPropSupportedComponents,
-            &[
-                "OfxImageComponentRGBA",
-                "OfxImageComponentRGB",
-                "OfxImageComponentAlpha",
-            ],
-        );
-        host_props.set_strs(
-            kOfxImageEffectPropSupportedContexts,
-            &[
-                "OfxImageEffectContextGeneral",
-                "OfxImageEffectContextFilter",
-                "OfxImageEffectContextTransition",
-            ],
-        );
-        host_props.set_strs(
-            kOfxImageEffectPropSupportedPixelDepths,
-            &["OfxBitDepthByte", "OfxBitDepthShort", "OfxBitDepthFloat"],
-        );
-        host_props.set_int(kOfxImageEffectPropSupportsMultipleClipDepths, &[0]);
-        host_props.set_int(kOfxImageEffectPropSupportsMultipleClipPARs, &[0]);
-        host_props.set_int(kOfxParamHostPropSupportsStringAnimation, &[0]);
-        host_props.set_int(kOfxParamHostPropMaxParameters, &[-1]);
+        let host_props = host_properties();
         let host = Box::new(OfxHost {
             host: host_props.handle(),
             fetchSuite: Some(fetch_suite),
         });
 
-        // SAFETY: the symbols have the OFX signatures; the library stays loaded
-        // (owned by the Bundle) for as long as anything it returned is used.
-        let plugins = unsafe {
-            if let Ok(set_host) =
-                lib.get::<unsafe extern "C" fn(*const OfxHost) -> OfxStatus>(b"OfxSetHost\0")
-            {
-                let st = set_host(&*host);
-                if st != kOfxStatOK {
-                    return Err(HostError::failed(format!(
-                        "OfxSetHost failed with status {st}"
-                    )));
-                }
-            }
-            let count = lib
-                .get::<unsafe extern "C" fn() -> c_int>(b"OfxGetNumberOfPlugins\0")
-                .map_err(|e| {
-                    HostError::bad(format!("{}: not an OFX bundle: {e}", binary.display()))
-                })?;
-            let get = lib
-                .get::<unsafe extern "C" fn(c_int) -> *mut OfxPlugin>(b"OfxGetPlugin\0")
-                .map_err(|e| {
-                    HostError::bad(format!("{}: not an OFX bundle: {e}", binary.display()))
-                })?;
-            let mut plugins = Vec::new();
-            for i in 0..count() {
-                let p = get(i);
-                let Some(plugin) = p.as_ref() else { continue };
-                if let Some(set_host) = plugin.setHost {
-                    set_host(&*host as *const OfxHost as *mut OfxHost);
-                }
-                plugins.push(PluginInfo {
-                    served_by: plugin
-                        .mainEntry
-                        .and_then(|f| object_holding(f as *const c_void)),
-                    id: CStr::from_ptr(plugin.pluginIdentifier)
-                        .to_string_lossy()
-                        .into_owned(),
-                    version: (plugin.pluginVersionMajor, plugin.pluginVersionMinor),
-                    plugin: p,
-                });
-            }
-            plugins
-        };
+        // SAFETY: `lib` is the OFX bundle just loaded, and the Bundle keeps
+        // it and `host` alive for as long as anything it returned is used.
+        let plugins = unsafe { plugins_of(&lib, &host, &binary)? };
         Ok(Bundle {
             binary,
             plugins,
@@ -320,29 +384,39 @@ impl Bundle {
             ))
         })?;
         let plugin = info.plugin;
-        let check = |st: OfxStatus, what: &str, effect: Option<&Effect>| -> Result<(), HostError> {
-            if st == kOfxStatOK || st == kOfxStatReplyDefault {
-                Ok(())
-            } else {
-                Err(failure(st, what, effect))
-            }
-        };
         self.send_load(plugin)?;
+        let descriptor = self.describe(plugin, id, context)?;
+        let effect = instance_effect(&descriptor, context);
+        let st = self.call(
+            plugin,
+            kOfxActionCreateInstance,
+            effect.handle() as *const c_void,
+            None,
+            None,
+        );
+        accept(st, "createInstance", &effect)?;
+        Ok(Instance {
+            bundle: self,
+            plugin,
+            _descriptor: descriptor,
+            effect,
+        })
+    }
+
+    /// Describe, then describe in `context`: the plugin's descriptor.
+    fn describe(
+        &self,
+        plugin: *const OfxPlugin,
+        id: &str,
+        context: &str,
+    ) -> Result<Box<Effect>, HostError> {
         let descriptor = Effect::new();
         descriptor
             .props
             .set_str(kOfxPropType, "OfxTypeImageEffectHost");
-        check(
-            self.call(
-                plugin,
-                kOfxActionDescribe,
-                descriptor.handle() as *const c_void,
-                None,
-                None,
-            ),
-            "describe",
-            Some(&descriptor),
-        )?;
+        let handle = descriptor.handle() as *const c_void;
+        let st = self.call(plugin, kOfxActionDescribe, handle, None, None);
+        accept(st, "describe", &descriptor)?;
         let contexts = descriptor.props.strs(kOfxImageEffectPropSupportedContexts);
         if !contexts.iter().any(|c| c == context) {
             return Err(HostError::bad(format!(
@@ -352,67 +426,10 @@ impl Bundle {
         }
         let in_args = PropertySet::new();
         in_args.set_str(kOfxImageEffectPropContext, context);
-        check(
-            self.call(
-                plugin,
-                kOfxImageEffectActionDescribeInContext,
-                descriptor.handle() as *const c_void,
-                Some(&in_args),
-                None,
-            ),
-            "describeInContext",
-            Some(&descriptor),
-        )?;
-
-        let effect = Effect::new();
-        for (k, v) in [
-            (kOfxPropType, "OfxTypeImageEffectInstance"),
-            (kOfxImageEffectPropContext, context),
-        ] {
-            effect.props.set_str(k, v);
-        }
-        effect
-            .props
-            .set_double(kOfxImageEffectPropFrameRate, &[24.0]);
-        effect
-            .props
-            .set_double(kOfxImageEffectPropProjectPixelAspectRatio, &[1.0]);
-        effect
-            .props
-            .set_ptr(kOfxPropInstanceData, std::ptr::null_mut());
-        let desc_params = params::ParamSet::instance_of(&descriptor.params);
-        *effect
-            .params
-            .params
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()) =
-            std::mem::take(&mut *desc_params.params.lock().unwrap_or_else(|e| e.into_inner()));
-        for name in descriptor.clip_names() {
-            let desc_clip = descriptor.clip(&name).expect("listed");
-            let clip = effect.add_clip(&name, desc_clip.props.clone_values());
-            clip.props.set_int(kOfxImageClipPropConnected, &[0]);
-            clip.props
-                .set_str(kOfxImageClipPropFieldOrder, "OfxImageFieldNone");
-            clip.props.set_double(kOfxImagePropPixelAspectRatio, &[1.0]);
-            clip.props.set_double(kOfxImageEffectPropFrameRate, &[24.0]);
-        }
-        check(
-            self.call(
-                plugin,
-                kOfxActionCreateInstance,
-                effect.handle() as *const c_void,
-                None,
-                None,
-            ),
-            "createInstance",
-            Some(&effect),
-        )?;
-        Ok(Instance {
-            bundle: self,
-            plugin,
-            _descriptor: descriptor,
-            effect,
-        })
+        let action = kOfxImageEffectActionDescribeInContext;
+        let st = self.call(plugin, action, handle, Some(&in_args), None);
+        accept(st, "describeInContext", &descriptor)?;
+        Ok(descriptor)
     }
 
     pub fn host(&self) -> &OfxHost {
@@ -879,6 +896,33 @@ impl Instance<'_> {
         spec: OutputSpec,
         field: &'static str,
     ) -> Result<Arc<Frame>, HostError> {
+        self.set_render_state(time, spec.render_scale, field);
+        let bounds = self.output_bounds(time, spec.render_scale)?;
+        if spec.identity {
+            if let Some((clip, at)) = self.identity(time, bounds, spec.render_scale)? {
+                return Ok(self.pass_through(&clip, at, bounds, spec));
+            }
+        }
+        let mut out = Frame::blank(bounds, spec.channels, spec.depth, spec.top_down);
+        out.par = self.pixel_aspect();
+        let out = Arc::new(out);
+        let out_clip = self
+            .effect
+            .clip("Output")
+            .ok_or_else(|| HostError::failed("the plugin has no Output clip"))?;
+        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = Some(out.clone());
+        out_clip
+            .props
+            .set_str(kOfxImageEffectPropPixelDepth, spec.depth);
+        let result = self.render_tiles(time, spec, field, bounds);
+        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        result?;
+        Ok(out)
+    }
+
+    /// What the plugin may ask the host during a render: the field, the
+    /// time on the timeline and the render scale.
+    fn set_render_state(&self, time: f64, scale: (f64, f64), field: &'static str) {
         *self.effect.field.lock().unwrap_or_else(|e| e.into_inner()) = field;
         self.effect.take_messages();
         self.effect
@@ -890,9 +934,13 @@ impl Instance<'_> {
             .effect
             .render_scale
             .lock()
-            .unwrap_or_else(|e| e.into_inner()) = spec.render_scale;
-        let rod = self.region_of_definition(time, spec.render_scale)?;
-        // An infinite region is rendered where a viewer shows it: the project.
+            .unwrap_or_else(|e| e.into_inner()) = scale;
+    }
+
+    /// The pixels to render: the region of definition at `scale` (the
+    /// project where it is infinite, as a viewer shows it).
+    fn output_bounds(&self, time: f64, scale: (f64, f64)) -> Result<RectI, HostError> {
+        let rod = self.region_of_definition(time, scale)?;
         let rod = if rod.x1 <= i32::MIN / 2 || rod.x2 >= i32::MAX / 2 {
             rod.intersect(&self.project_rect())
         } else {
@@ -900,41 +948,37 @@ impl Instance<'_> {
         };
         // Pixels: canonical x divided by the pixel aspect ratio.
         let par = self.pixel_aspect();
-        let (sx, sy) = spec.render_scale;
-        let bounds = RectI::new(
+        let (sx, sy) = scale;
+        Ok(RectI::new(
             (rod.x1 as f64 * sx / par).floor() as i32,
             (rod.y1 as f64 * sy).floor() as i32,
             (rod.x2 as f64 * sx / par).ceil() as i32,
             (rod.y2 as f64 * sy).ceil() as i32,
-        );
-        if spec.identity {
-            if let Some((clip, at)) = self.identity(time, bounds, spec.render_scale)? {
-                let source = self
-                    .effect
-                    .clip(&clip)
-                    .and_then(|c| c.frame_at(at).ok().flatten());
-                let image = match source {
-                    Some(f) => frame::with_channels(&f.to_image(), spec.channels),
-                    None => morphfx::image::Image::new(bounds, spec.channels),
-                };
-                return Ok(Arc::new(Frame::from_image(
-                    &image,
-                    spec.depth,
-                    spec.top_down,
-                )));
-            }
-        }
-        let mut out = Frame::blank(bounds, spec.channels, spec.depth, spec.top_down);
-        out.par = par;
-        let out = Arc::new(out);
-        let out_clip = self
+        ))
+    }
+
+    /// An identity render: the clip's frame at `at`, as the host copies it.
+    fn pass_through(&self, clip: &str, at: f64, bounds: RectI, spec: OutputSpec) -> Arc<Frame> {
+        let source = self
             .effect
-            .clip("Output")
-            .ok_or_else(|| HostError::failed("the plugin has no Output clip"))?;
-        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = Some(out.clone());
-        out_clip
-            .props
-            .set_str(kOfxImageEffectPropPixelDepth, spec.depth);
+            .clip(clip)
+            .and_then(|c| c.frame_at(at).ok().flatten());
+        let image = match source {
+            Some(f) => frame::with_channels(&f.to_image(), spec.channels),
+            None => morphfx::image::Image::new(bounds, spec.channels),
+        };
+        Arc::new(Frame::from_image(&image, spec.depth, spec.top_down))
+    }
+
+    /// The render action over `spec.tiles` horizontal bands of `bounds`,
+    /// each on its own thread as a multi-threaded host would.
+    fn render_tiles(
+        &self,
+        time: f64,
+        spec: OutputSpec,
+        field: &'static str,
+        bounds: RectI,
+    ) -> Result<(), HostError> {
         let tiles = spec.tiles.max(1) as i32;
         let band = (bounds.height() as i32 + tiles - 1) / tiles;
         let windows: Vec<RectI> = (0..tiles)
@@ -948,6 +992,7 @@ impl Instance<'_> {
             })
             .filter(|w| !w.is_empty())
             .collect();
+        let (sx, sy) = spec.render_scale;
         let render_one = |w: RectI| {
             let a = PropertySet::new();
             a.set_double(kOfxPropTime, &[time]);
@@ -960,27 +1005,21 @@ impl Instance<'_> {
             );
             a.set_int(kOfxImageEffectPropInteractiveRenderStatus, &[0]);
             self.act(kOfxImageEffectActionRender, Some(&a), None)
+                .map(|_| ())
         };
-        let result: Result<Vec<_>, HostError> = if windows.len() == 1 {
-            windows.iter().map(|w| render_one(*w)).collect()
-        } else {
-            std::thread::scope(|s| {
-                let handles: Vec<_> = windows
-                    .iter()
-                    .map(|w| s.spawn(move || render_one(*w)))
-                    .collect();
-                handles
-                    .into_iter()
-                    .map(|h| {
-                        h.join()
-                            .unwrap_or_else(|_| Err(HostError::failed("render thread panicked")))
-                    })
-                    .collect()
+        if windows.len() == 1 {
+            return render_one(windows[0]);
+        }
+        std::thread::scope(|s| {
+            let handles: Vec<_> = windows
+                .iter()
+                .map(|w| s.spawn(move || render_one(*w)))
+                .collect();
+            handles.into_iter().try_for_each(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err(HostError::failed("render thread panicked")))
             })
-        };
-        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = None;
-        result?;
-        Ok(out)
+        })
     }
 }
 

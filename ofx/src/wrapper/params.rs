@@ -123,6 +123,12 @@ fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &Para
         let _ = p.set_double(kOfxParamPropDisplayMax, 0, 1.0);
         return Ok(());
     }
+    set_common(&p, spec)?;
+    set_kind(&p, &spec.kind)
+}
+
+/// Label, hint, script name, parent and animation: what every visible param has.
+fn set_common(p: &PropSet, spec: &ParamSpec) -> Outcome {
     p.set_string(kOfxPropLabel, 0, &spec.label)?;
     // Optional properties: a minimal host may not know them; defining still succeeds.
     let _ = p.set_string(kOfxParamPropHint, 0, &spec.hint);
@@ -133,7 +139,12 @@ fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &Para
     if !matches!(spec.kind, Kind::Group { .. }) {
         let _ = p.set_int(kOfxParamPropAnimates, 0, spec.animates as i32);
     }
-    match &spec.kind {
+    Ok(())
+}
+
+/// The properties of the param's type: default, range, options, mode.
+fn set_kind(p: &PropSet, kind: &Kind) -> Outcome {
+    match kind {
         Kind::Double {
             default,
             min,
@@ -193,13 +204,7 @@ fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &Para
                 TextMode::FilePath => kOfxParamStringIsFilePath,
             };
             let _ = p.set_string(kOfxParamPropStringMode, 0, &mode.to_string_lossy());
-            if matches!(
-                spec.kind,
-                Kind::Text {
-                    mode: TextMode::FilePath,
-                    ..
-                }
-            ) {
+            if mode == kOfxParamStringIsFilePath {
                 let _ = p.set_int(kOfxParamPropStringFilePathExists, 0, 1);
             }
         }

@@ -57,34 +57,52 @@ pub fn sample(
         return std::array::from_fn(|c| p[c] + w1 * (q[c] - p[c]) + w2 * (r[c] - p[c]));
     }
     let b = a + len;
-    let mut acc = [0f32; 4];
     if !(a.is_finite() && b.is_finite()) {
-        return acc;
+        return [0.0; 4];
+    }
+    if first >= 0.0 && b.ceil() - 1.0 < n as f64 {
+        box_inside(a, len, read)
+    } else {
+        box_across_edge(a, len, n, edge, read)
+    }
+}
+
+/// The mean over `[a, a + len]` (`len` at least one pixel) inside the line:
+/// partial end pixels, whole ones between.
+#[inline(always)]
+fn box_inside(a: f64, len: f64, read: impl Fn(usize) -> [f32; 4]) -> [f32; 4] {
+    let b = a + len;
+    let (first, last) = (a.floor(), b.ceil() - 1.0);
+    let (i0, i1) = (first as usize, last as usize);
+    if i0 == i1 {
+        return read(i0);
+    }
+    let (w0, w1) = ((first + 1.0 - a) as f32, (b - last) as f32);
+    let (p, q) = (read(i0), read(i1));
+    let mut acc: [f32; 4] = std::array::from_fn(|c| w0 * p[c] + w1 * q[c]);
+    for i in i0 + 1..i1 {
+        let v = read(i);
+        for c in 0..4 {
+            acc[c] += v[c];
+        }
     }
     let inv = (1.0 / len) as f32;
-    let last = b.ceil() - 1.0;
-    if first >= 0.0 && last < n as f64 {
-        // Inside the line: partial end pixels, whole ones between.
-        let (i0, i1) = (first as usize, last as usize);
-        if i0 == i1 {
-            return read(i0);
-        }
-        let (w0, w1) = ((first + 1.0 - a) as f32, (b - last) as f32);
-        let (p, q) = (read(i0), read(i1));
-        for c in 0..4 {
-            acc[c] = w0 * p[c] + w1 * q[c];
-        }
-        for i in i0 + 1..i1 {
-            let v = read(i);
-            for c in 0..4 {
-                acc[c] += v[c];
-            }
-        }
-        return acc.map(|v| v * inv);
-    }
-    // Across an end of the line: each tap through the edge mode. A preimage
-    // longer than the whole line repeats it (mirror) or its end (clamp), so
-    // the loop is bounded.
+    acc.map(|v| v * inv)
+}
+
+/// The mean over `[a, a + len]` across an end of the line: each tap through the
+/// edge mode. A preimage longer than the whole line repeats it (mirror) or
+/// its end (clamp), so the loop is bounded.
+#[inline(always)]
+fn box_across_edge(
+    a: f64,
+    len: f64,
+    n: usize,
+    edge: EdgeMode,
+    read: impl Fn(usize) -> [f32; 4],
+) -> [f32; 4] {
+    let (first, b) = (a.floor(), a + len);
+    let mut acc = [0f32; 4];
     let count = ((b - first).ceil() as i64).clamp(1, 4 * n as i64 + 4);
     for k in 0..count {
         let i = first + k as f64;
@@ -102,6 +120,7 @@ pub fn sample(
             }
         }
     }
+    let inv = (1.0 / len) as f32;
     acc.map(|v| v * inv)
 }
 
