@@ -22,6 +22,7 @@ pub mod make_warp;
 pub mod morph;
 pub mod scene;
 pub mod snake;
+pub mod strokes;
 pub mod testing;
 pub mod transition;
 pub mod views;

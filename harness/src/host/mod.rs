@@ -4,6 +4,7 @@
 
 pub mod effect;
 pub mod frame;
+pub mod overlay;
 pub mod params;
 pub mod props;
 pub mod services;
@@ -66,6 +67,24 @@ impl std::fmt::Display for HostError {
     }
 }
 impl std::error::Error for HostError {}
+
+/// What a host offers beyond the basics.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct HostOptions {
+    /// Overlay interacts (and the interact suite), as a host with a viewer.
+    pub overlays: bool,
+    /// The OFX 1.5 Draw suite, recording every call.
+    pub draw_suite: bool,
+}
+
+/// Whether the loaded host whose property set is `host` has int property
+/// `name` set to 1.
+fn offers(host: OfxPropertySetHandle, name: &CStr) -> bool {
+    // SAFETY: `host` is one of our host property sets (fetchSuite checked
+    // it is in LOADED_HOSTS, which holds only live hosts' sets).
+    let props = unsafe { &*(host as *const PropertySet) };
+    props.ints(name).first() == Some(&1)
+}
 
 /// Host structs (by their property set) whose plugins have been sent the
 /// load action: before it, the spec lets a plugin fetch no suite.
@@ -130,7 +149,13 @@ unsafe extern "C" fn fetch_suite(
             &services::PROGRESS_SUITE_V2 as *const _ as *const c_void
         }
         (n, 1) if n == kOfxTimeLineSuite => &services::TIME_LINE_SUITE as *const _ as *const c_void,
-        // Anything else (interact, OpenGL, ...) this host does not provide: a
+        (n, 1) if n == overlay::kOfxInteractSuite && offers(host, kOfxImageEffectPropSupportsOverlays) => {
+            &overlay::INTERACT_SUITE as *const _ as *const c_void
+        }
+        (n, 1) if n == overlay::kOfxDrawSuite && offers(host, overlay::DRAW_SUITE_PROP) => {
+            &overlay::DRAW_SUITE as *const _ as *const c_void
+        }
+        // Anything else (OpenGL render, dialogs, ...) this host does not provide: a
         // null answer is how OFX says so.
         _ => std::ptr::null(),
     }
@@ -221,12 +246,13 @@ fn instance_effect(descriptor: &Effect, context: &str) -> Box<Effect> {
 }
 
 /// What our host says it is and supports (the host descriptor's properties).
-fn host_properties() -> Box<PropertySet> {
+fn host_properties(options: HostOptions) -> Box<PropertySet> {
     let host_props = Box::new(PropertySet::new());
     host_props.set_str(kOfxPropName, "net.morphfx.harness");
     host_props.set_str(kOfxPropLabel, "morphfx harness");
     host_props.set_int(kOfxImageEffectHostPropIsBackground, &[1]);
-    host_props.set_int(kOfxImageEffectPropSupportsOverlays, &[0]);
+    host_props.set_int(kOfxImageEffectPropSupportsOverlays, &[options.overlays as i32]);
+    host_props.set_int(overlay::DRAW_SUITE_PROP, &[options.draw_suite as i32]);
     host_props.set_int(kOfxImageEffectPropSupportsMultiResolution, &[1]);
     host_props.set_int(kOfxImageEffectPropSupportsTiles, &[1]);
     host_props.set_int(kOfxImageEffectPropTemporalClipAccess, &[1]);
@@ -324,6 +350,11 @@ pub fn bundle_binary(path: &Path) -> PathBuf {
 
 impl Bundle {
     pub fn load(path: &Path) -> Result<Bundle, HostError> {
+        Bundle::load_with(path, HostOptions::default())
+    }
+
+    /// Loads the bundle into a host with `options`.
+    pub fn load_with(path: &Path, options: HostOptions) -> Result<Bundle, HostError> {
         let binary = bundle_binary(path);
         if !binary.is_file() {
             return Err(HostError::bad(format!(
@@ -336,7 +367,7 @@ impl Bundle {
         // is such a library by contract, and we load only the path we were given.
         let lib = unsafe { libloading::Library::new(&binary) }
             .map_err(|e| HostError::bad(format!("plugin bundle {}: {e}", binary.display())))?;
-        let host_props = host_properties();
+        let host_props = host_properties(options);
         let host = Box::new(OfxHost {
             host: host_props.handle(),
             fetchSuite: Some(fetch_suite),

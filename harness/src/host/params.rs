@@ -339,8 +339,8 @@ thread_local! {
 }
 
 /// Marks this thread as inside `action` until dropped: the spec lets a
-/// plugin set param values only from the instance-changed action (and
-/// interacts), so a write anywhere else is a violation.
+/// plugin set param values only from the instance-changed action and
+/// interacts' events, so a write anywhere else is a violation.
 pub struct Inside;
 
 impl Inside {
@@ -360,7 +360,20 @@ impl Drop for Inside {
 /// render, a thread of the plugin's own, another action).
 fn check_write_allowed(param: &str) {
     let action = ACTIONS.with(|a| a.borrow().last().cloned());
-    if action.as_deref() != Some("OfxActionInstanceChanged") {
+    // Interacts edit params too (a drag in the viewer), from their pen and
+    // key actions.
+    let allowed = matches!(
+        action.as_deref(),
+        Some(
+            "OfxActionInstanceChanged"
+                | "OfxInteractActionPenDown"
+                | "OfxInteractActionPenMotion"
+                | "OfxInteractActionPenUp"
+                | "OfxInteractActionKeyDown"
+                | "OfxInteractActionKeyRepeat"
+        )
+    );
+    if !allowed {
         super::violation(format!(
             "param {param} written in {} (only the instance-changed action may set values)",
             action.as_deref().unwrap_or("a thread outside any action")

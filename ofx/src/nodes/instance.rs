@@ -44,6 +44,8 @@ pub struct Instance {
     /// Per-pixel dissolve weights of non-uniform colour transitions, keyed
     /// like the warps they come from.
     pub weights: Cache<Weights>,
+    /// The viewer overlay's hover, drag and held keys.
+    pub overlay: Mutex<super::overlay::State>,
 }
 
 /// Solved grids kept for warm starts.
@@ -94,6 +96,7 @@ pub fn create(kind: NodeKind, effect: &Effect) -> Outcome {
     let params = effect
         .param_set()?
         .bind(table.iter().map(|p| p.id.as_str()));
+    super::lines::hide_unused(kind, &params, 0.0);
     let instance = Instance {
         params: Some(params),
         ..Instance::default()

@@ -2,7 +2,9 @@
 //! and what each does per action. All host access goes through `wrapper`.
 
 mod instance;
+mod lines;
 pub mod morph;
+pub mod overlay;
 pub mod params;
 mod render;
 mod snap;
@@ -115,11 +117,27 @@ pub fn action(
         render::render(kind, &effect, &in_props()?)?;
         crate::wrapper::dispatch::render_succeeded(&effect);
     } else if is(action, kOfxActionInstanceChanged) {
-        snap::instance_changed(kind, &effect, &in_props()?)?;
+        instance_changed(kind, &effect, &in_props()?)?;
     } else {
         return Ok(Reply::Default);
     }
     Ok(Reply::Done)
+}
+
+/// A param changed: the buttons act, Line Count shows its slots.
+fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
+    let name = in_args.get_string(kOfxPropName, 0)?;
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    if name == params::SNAP_LINES {
+        snap::snap_lines(kind, effect, time)
+    } else if name == params::LINE_COUNT {
+        lines::hide_unused(kind, instance::get(effect)?.params()?, time);
+        Ok(())
+    } else if let Some(k) = params::clear_button_slot(&name) {
+        lines::clear(kind, instance::get(effect)?.params()?, k, time)
+    } else {
+        Ok(())
+    }
 }
 
 fn describe(kind: NodeKind, effect: &Effect) -> Outcome {
@@ -161,6 +179,13 @@ fn describe(kind: NodeKind, effect: &Effect) -> Outcome {
     // Warm starts make a sequence cheaper in frame order, but any order is
     // correct (they are only used when the host says it renders in order).
     let _ = p.set_int(kOfxImageEffectInstancePropSequentialRender, 0, 2);
+    // The viewer overlay: OpenGL (V1) for every host that draws overlays,
+    // the Draw suite entry (V2) only where the host offers that suite.
+    let entry = crate::wrapper::interact::entry(kind);
+    let _ = p.set_pointer(kOfxImageEffectPluginPropOverlayInteractV1, 0, entry);
+    if crate::wrapper::host::suites().is_ok_and(|s| s.draw.is_some()) {
+        let _ = p.set_pointer(kOfxImageEffectPluginPropOverlayInteractV2, 0, entry);
+    }
     Ok(())
 }
 

@@ -23,8 +23,8 @@ use super::NodeKind;
 use crate::wrapper::params::Params;
 use crate::wrapper::Outcome;
 
-/// Line-pair slots every node offers.
-pub const LINE_SLOTS: usize = 16;
+/// Line-pair slots every node offers (a face takes 30 to 60 lines).
+pub const LINE_SLOTS: usize = 64;
 
 pub const METHOD: &str = "method";
 pub const PROGRESS: &str = "progress";
@@ -47,6 +47,8 @@ pub const VIEW: &str = "view";
 pub const MESH_PASS: &str = "mesh_pass";
 pub const SNAP_LINES: &str = "snap_lines";
 pub const SNAP_SIGMA: &str = "snap_sigma";
+pub const OVERLAY_SHOW: &str = "overlay_show";
+pub const OVERLAY_EDIT: &str = "overlay_edit";
 pub const AUTO_LEVELS: &str = "auto_levels";
 pub const AUTO_COLOUR: &str = "auto_colour";
 pub const AUTO_STRETCH: &str = "auto_stretch";
@@ -61,6 +63,72 @@ pub const TRANSITION_AFFECTS: &str = "transition_affects";
 pub const TRANSITION_SPREAD: &str = "transition_spread";
 pub const TRANSITION_ANGLE: &str = "transition_angle";
 pub const TRANSITION_CYCLES: &str = "transition_cycles";
+
+/// The group holding line slot `k`'s params.
+pub fn slot_group(k: usize) -> String {
+    format!("line{k}_group")
+}
+
+/// Line slot `k`'s Clear Line button.
+pub fn slot_clear(k: usize) -> String {
+    format!("line{k}_clear")
+}
+
+/// The slot whose Clear Line button `id` is.
+pub fn clear_button_slot(id: &str) -> Option<usize> {
+    let k: usize = id.strip_prefix("line")?.strip_suffix("_clear")?.parse().ok()?;
+    (1..=LINE_SLOTS).contains(&k).then_some(k)
+}
+
+/// What the viewer overlay shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Show {
+    /// A's and B's lines, their connectors and the in-between lines.
+    Both,
+    /// A's lines only.
+    A,
+    /// B's lines only.
+    B,
+    /// The in-between lines at the current progress only.
+    Between,
+    /// Nothing.
+    Off,
+}
+
+impl Choice for Show {
+    const ALL: &'static [Self] = &[Show::Both, Show::A, Show::B, Show::Between, Show::Off];
+    fn name(self) -> &'static str {
+        match self {
+            Show::Both => "A and B",
+            Show::A => "A only",
+            Show::B => "B only",
+            Show::Between => "in-between",
+            Show::Off => "off",
+        }
+    }
+}
+
+/// Which lines the overlay lets the pen move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EditSides {
+    /// A's and B's.
+    Both,
+    /// A's only (B's are drawn, locked).
+    A,
+    /// B's only.
+    B,
+}
+
+impl Choice for EditSides {
+    const ALL: &'static [Self] = &[EditSides::Both, EditSides::A, EditSides::B];
+    fn name(self) -> &'static str {
+        match self {
+            EditSides::Both => "A and B",
+            EditSides::A => "A only",
+            EditSides::B => "B only",
+        }
+    }
+}
 
 /// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
 pub fn slot_ids(k: usize) -> [String; 5] {
@@ -221,35 +289,11 @@ fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
         ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(SNAP_SIGMA, "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Kind::Double { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group("lines_group").animated(false),
+        ParamSpec::new(OVERLAY_SHOW, "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", choice(Show::Both)).in_group("lines_group").animated(false),
+        ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which lines the pen moves in the viewer. Drag an end, or a line by its middle; drag in empty space to draw a new line. Hold Shift to grab only A's lines, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
     ];
     for k in 1..=LINE_SLOTS {
-        let [enable, a0, a1, b0, b1] = slot_ids(k);
-        let y = 100.0 + 40.0 * (k as f64 - 1.0);
-        t.push(
-            ParamSpec::new(
-                enable,
-                format!("Line {k}"),
-                format!("Use line pair {k}."),
-                Kind::Bool { default: true },
-            )
-            .in_group("lines_group"),
-        );
-        for (id, label, x) in [
-            (a0, "A Start", 100.0),
-            (a1, "A End", 300.0),
-            (b0, "B Start", 100.0),
-            (b1, "B End", 300.0),
-        ] {
-            t.push(
-                ParamSpec::new(
-                    id,
-                    format!("Line {k} {label}"),
-                    format!("Line {k}: {label} (canonical pixels, y up)."),
-                    Kind::Point { default: (x, y) },
-                )
-                .in_group("lines_group"),
-            );
-        }
+        t.extend(slot_specs(k));
     }
     t.extend([
         ParamSpec::new(
@@ -330,6 +374,57 @@ fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ),
     ]);
     t
+}
+
+/// Line slot `k`'s params, in their own group: enable, the four ends, Clear.
+fn slot_specs(k: usize) -> Vec<ParamSpec> {
+    let [enable, a0, a1, b0, b1] = slot_ids(k);
+    let group = slot_group(k);
+    // Default lines stacked down the frame, so slots added one by one in a
+    // host without the overlay do not all start on top of each other.
+    let y = 100.0 + 40.0 * ((k - 1) % 16) as f64;
+    let mut specs = vec![
+        ParamSpec::new(
+            group.clone(),
+            format!("Line {k}"),
+            format!("Line pair {k}"),
+            Kind::Group { open: false },
+        )
+        .in_group("lines_group"),
+        ParamSpec::new(
+            enable,
+            "Enabled",
+            format!("Use line pair {k}."),
+            Kind::Bool { default: true },
+        )
+        .in_group(group.clone()),
+    ];
+    for (id, label, x) in [
+        (a0, "A Start", 100.0),
+        (a1, "A End", 300.0),
+        (b0, "B Start", 100.0),
+        (b1, "B End", 300.0),
+    ] {
+        specs.push(
+            ParamSpec::new(
+                id,
+                format!("Line {k} {label}"),
+                format!("Line {k}: {label} (canonical pixels, y up)."),
+                Kind::Point { default: (x, y) },
+            )
+            .in_group(group.clone()),
+        );
+    }
+    specs.push(
+        ParamSpec::new(
+            slot_clear(k),
+            "Clear Line",
+            format!("Removes line {k}'s keys, puts it back where it started and turns it off."),
+            Kind::Button,
+        )
+        .in_group(group),
+    );
+    specs
 }
 
 /// The params a node defines in `context`: its table, and in the
@@ -451,7 +546,7 @@ impl<'a> Reader<'a> {
     }
 
     /// A [`Choice`] param defined with [`choice`].
-    fn choice<C: Choice>(&self, id: &str) -> C {
+    pub fn choice<C: Choice>(&self, id: &str) -> C {
         self.pick(id, C::ALL)
     }
 
@@ -609,22 +704,13 @@ fn transition_settings(r: &Reader<'_>) -> TransitionSettings {
 
 /// The enabled line slots with both lines placed, as features.
 fn lines(r: &Reader<'_>) -> Vec<Feature> {
-    let mut lines = Vec::new();
-    for k in 1..=r.int(LINE_COUNT) as usize {
-        let [enable, a0, a1, b0, b1] = slot_ids(k);
-        if !r.bool(&enable) {
-            continue;
-        }
-        let [a0, a1, b0, b1] = [&a0, &a1, &b0, &b1].map(|id| r.point(id));
-        // A zero-length line has no direction: the slot is skipped, not an
-        // error, so a half-placed line never breaks a render.
-        if let (Some(a0), Some(a1), Some(b0), Some(b1)) = (a0, a1, b0, b1) {
-            if a0 != a1 && b0 != b1 && [a0, a1, b0, b1].iter().all(|p| p.is_finite()) {
-                lines.push(Feature::line([a0, a1], [b0, b1]).named(format!("line {k}")));
-            }
-        }
-    }
-    lines
+    // A zero-length line has no direction: the slot is skipped, not an
+    // error, so a half-placed line never breaks a render.
+    super::lines::slot_lines(r)
+        .into_iter()
+        .filter(|l| l.a[0] != l.a[1] && l.b[0] != l.b[1])
+        .map(|l| Feature::line(l.a, l.b).named(format!("line {}", l.slot)))
+        .collect()
 }
 
 #[cfg(test)]

@@ -7,21 +7,15 @@
 use morphfx::features::FeatureKind;
 use morphfx::geom::{PixelScale, Vec2};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
-use openfx::sys::generic::core::*;
 
-use super::params::{slot_ids, Reader, Settings, LINE_COUNT, SNAP_LINES, SNAP_SIGMA};
+use super::params::{slot_ids, Reader, Settings, LINE_COUNT, SNAP_SIGMA};
 use super::render::context;
 use super::{instance, NodeKind};
 use crate::wrapper::clips::{Depth, Effect};
-use crate::wrapper::props::PropSet;
 use crate::wrapper::{Failure, Outcome};
 
-/// Handles instanceChanged: only the Snap Lines button does anything.
-pub fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
-    if in_args.get_string(kOfxPropName, 0)? != SNAP_LINES {
-        return Ok(());
-    }
-    let time = in_args.get_double(kOfxPropTime, 0)?;
+/// The Snap Lines button, pressed at `time`.
+pub fn snap_lines(kind: NodeKind, effect: &Effect, time: f64) -> Outcome {
     let instance = instance::get(effect)?;
     let params = instance.params()?;
     let settings = Settings::read(params, time, kind);

@@ -56,7 +56,7 @@ pub struct ParamSpec {
     pub label: String,
     pub hint: String,
     pub kind: Kind,
-    pub group: Option<&'static str>,
+    pub group: Option<String>,
     pub animates: bool,
 }
 
@@ -84,8 +84,8 @@ impl ParamSpec {
             animates,
         }
     }
-    pub fn in_group(mut self, group: &'static str) -> Self {
-        self.group = Some(group);
+    pub fn in_group(mut self, group: impl Into<String>) -> Self {
+        self.group = Some(group.into());
         self
     }
     pub fn animated(mut self, animates: bool) -> Self {

@@ -7,6 +7,8 @@ use std::sync::RwLock;
 use openfx::sys::generic::core::*;
 use openfx::sys::generic::property::*;
 use openfx::sys::image_effect_v1::image_effect::*;
+use openfx::sys::image_effect_v1::draw_suite::*;
+use openfx::sys::image_effect_v1::interact::*;
 use openfx::sys::image_effect_v1::message::*;
 use openfx::sys::image_effect_v1::param::*;
 
@@ -20,6 +22,10 @@ pub struct Suites {
     pub message: Option<&'static OfxMessageSuiteV1>,
     /// Persistent messages (render errors stay on the node until cleared).
     pub message_v2: Option<&'static OfxMessageSuiteV2>,
+    /// Interacts: their properties and redraw requests (overlays).
+    pub interact: Option<&'static OfxInteractSuiteV1>,
+    /// OFX 1.5 drawing without OpenGL (overlays).
+    pub draw: Option<&'static OfxDrawSuiteV1>,
 }
 
 // SAFETY: the suites are immutable function tables the host keeps alive for as
@@ -82,6 +88,8 @@ pub fn load() -> Outcome {
     let param = required(kOfxParameterSuite, 1)? as *const OfxParameterSuiteV1;
     let message = get(kOfxMessageSuite, 1) as *const OfxMessageSuiteV1;
     let message_v2 = get(kOfxMessageSuite, 2) as *const OfxMessageSuiteV2;
+    let interact = get(kOfxInteractSuite, 1) as *const OfxInteractSuiteV1;
+    let draw = get(kOfxDrawSuite, 1) as *const OfxDrawSuiteV1;
     // SAFETY: the host returned these pointers for the named suite versions;
     // they stay valid until the binary is unloaded.
     let suites = unsafe {
@@ -91,6 +99,8 @@ pub fn load() -> Outcome {
             param: &*param,
             message: message.as_ref(),
             message_v2: message_v2.as_ref(),
+            interact: interact.as_ref(),
+            draw: draw.as_ref(),
         }
     };
     switches();

@@ -5,8 +5,11 @@
 pub mod clips;
 pub mod cpu;
 pub mod dispatch;
+mod draw;
 mod exports;
+mod gl;
 pub mod host;
+pub mod interact;
 pub mod params;
 pub mod props;
 

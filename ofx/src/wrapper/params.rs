@@ -133,7 +133,7 @@ fn set_common(p: &PropSet, spec: &ParamSpec) -> Outcome {
     // Optional properties: a minimal host may not know them; defining still succeeds.
     let _ = p.set_string(kOfxParamPropHint, 0, &spec.hint);
     let _ = p.set_string(kOfxParamPropScriptName, 0, &spec.id);
-    if let Some(g) = spec.group {
+    if let Some(g) = &spec.group {
         let _ = p.set_string(kOfxParamPropParent, 0, g);
     }
     if !matches!(spec.kind, Kind::Group { .. }) {
@@ -177,6 +177,9 @@ fn set_kind(p: &PropSet, kind: &Kind) -> Outcome {
         }
         Kind::Point { default } => {
             p.set_doubles(kOfxParamPropDefault, &[default.0, default.1])?;
+            // The host's own point handle stays, beside our overlay; a host
+            // that does not know the property refuses it, and that is fine.
+            let _ = p.set_int(kOfxParamPropUseHostOverlayHandle, 0, 1);
             // A real range and display range: hosts that find none clamp
             // (Resolve to -1..1). Positions may lie outside the frame
             // (overscan), so the range is wide; sliders show a 4K frame.
@@ -293,6 +296,103 @@ impl Params {
         let h = self.handle(id)?;
         // SAFETY: a Double2D param takes two `double` varargs after the time.
         check(unsafe { f(h, time, x, y) }, &format!("setting {id}"))
+    }
+
+    /// Sets a Double2D param's value (a param without keys).
+    pub fn set_point(&self, id: &str, (x, y): (f64, f64)) -> Outcome {
+        let f = self
+            .set
+            .suite
+            .paramSetValue
+            .ok_or_else(|| Failure::Failed("host has no paramSetValue".into()))?;
+        let h = self.handle(id)?;
+        // SAFETY: a Double2D param takes two `double` varargs.
+        check(unsafe { f(h, x, y) }, &format!("setting {id}"))
+    }
+
+    /// Sets an Integer, Boolean or Choice param's value.
+    pub fn set_int(&self, id: &str, v: i32) -> Outcome {
+        let f = self
+            .set
+            .suite
+            .paramSetValue
+            .ok_or_else(|| Failure::Failed("host has no paramSetValue".into()))?;
+        let h = self.handle(id)?;
+        // SAFETY: Integer, Boolean and Choice params take one `int` vararg.
+        check(unsafe { f(h, v as c_int) }, &format!("setting {id}"))
+    }
+
+    /// Moves a point the user is editing: keyed at `time` when the param
+    /// already animates (other keys stay), set outright when it has none.
+    pub fn move_point(&self, id: &str, time: f64, p: (f64, f64)) -> Outcome {
+        if self.num_keys(id)? > 0 {
+            self.set_point_at(id, time, p)
+        } else {
+            self.set_point(id, p)
+        }
+    }
+
+    /// How many keys the param has.
+    pub fn num_keys(&self, id: &str) -> Outcome<u32> {
+        let f = self
+            .set
+            .suite
+            .paramGetNumKeys
+            .ok_or_else(|| Failure::Failed("host has no paramGetNumKeys".into()))?;
+        let h = self.handle(id)?;
+        let mut n: std::ffi::c_uint = 0;
+        // SAFETY: the param's handle and a live out-pointer.
+        check(unsafe { f(h, &mut n) }, &format!("counting keys of {id}"))?;
+        Ok(n)
+    }
+
+    /// Removes every key of the param (its value stays what it was).
+    pub fn delete_all_keys(&self, id: &str) -> Outcome {
+        let f = self
+            .set
+            .suite
+            .paramDeleteAllKeys
+            .ok_or_else(|| Failure::Failed("host has no paramDeleteAllKeys".into()))?;
+        let h = self.handle(id)?;
+        // SAFETY: the param's handle.
+        check(unsafe { f(h) }, &format!("deleting keys of {id}"))
+    }
+
+    /// Hides or shows the param in the host's UI (`kOfxParamPropSecret`).
+    pub fn set_secret(&self, id: &str, secret: bool) -> Outcome {
+        let f = self
+            .set
+            .suite
+            .paramGetPropertySet
+            .ok_or_else(|| Failure::Failed("host has no paramGetPropertySet".into()))?;
+        let h = self.handle(id)?;
+        let mut props: OfxPropertySetHandle = std::ptr::null_mut();
+        // SAFETY: the param's handle and a live out-pointer.
+        check(unsafe { f(h, &mut props) }, &format!("properties of {id}"))?;
+        // SAFETY: the host just returned the param's property set, which
+        // lives as long as the param.
+        let p = unsafe { PropSet::from_raw(props)? };
+        p.set_int(kOfxParamPropSecret, 0, secret as i32)
+    }
+
+    /// Opens an edit block that a later [`Params::end_edit`] closes: an
+    /// overlay drag spans several actions and is still one undo step.
+    pub fn begin_edit(&self, name: &str) -> Outcome {
+        let Some(begin) = self.set.suite.paramEditBegin else {
+            return Ok(()); // a host without edit blocks: plain writes
+        };
+        let label = cstr(name);
+        // SAFETY: the instance's param set and a NUL-terminated label.
+        check(unsafe { begin(self.set.set, label.as_ptr()) }, "paramEditBegin")
+    }
+
+    /// Closes the block [`Params::begin_edit`] opened.
+    pub fn end_edit(&self) -> Outcome {
+        let Some(end) = self.set.suite.paramEditEnd else {
+            return Ok(());
+        };
+        // SAFETY: the instance's param set.
+        check(unsafe { end(self.set.set) }, "paramEditEnd")
     }
 
     /// Runs `writes` inside one edit block (`paramEditBegin`/`paramEditEnd`):

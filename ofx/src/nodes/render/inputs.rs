@@ -56,7 +56,7 @@ pub struct WarpInputs {
     pub t: f64,
 }
 
-pub fn warp_inputs(
+pub(in crate::nodes) fn warp_inputs(
     kind: NodeKind,
     instance: &Instance,
     settings: &Settings,

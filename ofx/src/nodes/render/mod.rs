@@ -32,7 +32,8 @@ use crate::wrapper::clips::{Depth, Effect, HostImage, HostSample, ImageInfo};
 use crate::wrapper::props::PropSet;
 use crate::wrapper::{Failure, Outcome};
 use draw::Job;
-use inputs::{warp_inputs, WarpInputs};
+pub(super) use inputs::warp_inputs;
+use inputs::WarpInputs;
 pub use regions::{
     clip_preferences, frames_needed, is_identity, region_of_definition, regions_of_interest,
 };

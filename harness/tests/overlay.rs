@@ -1,0 +1,250 @@
+//! The viewer overlay through the C ABI, in a host with overlays and the
+//! Draw suite: what it draws, and how the pen edits the line params.
+
+mod common;
+
+use std::sync::OnceLock;
+
+use morphfx_harness::host::overlay::{Answer, DrawCall, Overlay};
+use morphfx_harness::host::params::take_edit_log;
+use morphfx_harness::host::{take_violations, Bundle, HostOptions, Instance};
+use openfx::sys::image_effect_v1::draw_suite::*;
+use openfx::sys::image_effect_v1::interact::*;
+
+fn bundle() -> &'static Bundle {
+    static B: OnceLock<Bundle> = OnceLock::new();
+    B.get_or_init(|| {
+        let options = HostOptions {
+            overlays: true,
+            draw_suite: true,
+        };
+        Bundle::load_with(&common::bundle_path(), options).expect("the bundle loads")
+    })
+}
+
+fn morph() -> Instance<'static> {
+    bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap()
+}
+
+/// Slot 1 keyed at frames 0 and 10 (A moves right by 20), slot 2 static.
+fn two_lines(inst: &Instance<'_>) {
+    inst.set_int("line_count", 2).unwrap();
+    inst.set_double("line1_a_start", &[100.0, 100.0], Some(0.0)).unwrap();
+    inst.set_double("line1_a_start", &[120.0, 100.0], Some(10.0)).unwrap();
+    inst.set_double("line1_a_end", &[200.0, 100.0], Some(0.0)).unwrap();
+    inst.set_double("line1_a_end", &[220.0, 100.0], Some(10.0)).unwrap();
+    inst.set_double("line1_b_start", &[100.0, 150.0], None).unwrap();
+    inst.set_double("line1_b_end", &[200.0, 150.0], None).unwrap();
+    inst.set_double("line2_a_start", &[50.0, 300.0], None).unwrap();
+    inst.set_double("line2_a_end", &[50.0, 400.0], None).unwrap();
+    inst.set_double("line2_b_start", &[60.0, 300.0], None).unwrap();
+    inst.set_double("line2_b_end", &[60.0, 420.0], None).unwrap();
+}
+
+fn overlay<'i>(inst: &'i Instance<'i>) -> Overlay<'i> {
+    Overlay::new(inst, true).unwrap().expect("the node declares an overlay")
+}
+
+/// Every segment drawn (pairs of `Lines` draws), in the colour pass (the
+/// shadow pass comes first and is offset by one pixel).
+fn segments(calls: &[DrawCall]) -> Vec<[[f64; 2]; 2]> {
+    let mut out = Vec::new();
+    for c in calls {
+        if let DrawCall::Draw { primitive, points } = c {
+            if *primitive == kOfxDrawPrimitiveLines {
+                out.extend(points.chunks(2).map(|p| [p[0], p[1]]));
+            }
+        }
+    }
+    out
+}
+
+fn texts(calls: &[DrawCall]) -> Vec<String> {
+    calls
+        .iter()
+        .filter_map(|c| match c {
+            DrawCall::Text { text, .. } => Some(text.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn draw_shows_every_enabled_line_at_its_values_at_the_time_with_labels() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    let calls = ov.draw(5.0, (1.0, 1.0)).unwrap();
+    let segs = segments(&calls);
+    // At frame 5 slot 1's A line is halfway between its keys.
+    for line in [
+        [[110.0, 100.0], [210.0, 100.0]],
+        [[100.0, 150.0], [200.0, 150.0]],
+        [[50.0, 300.0], [50.0, 400.0]],
+        [[60.0, 300.0], [60.0, 420.0]],
+    ] {
+        assert!(segs.contains(&line), "{line:?} drawn: {segs:?}");
+        // and its shadow, one pixel right and down
+        let shadow = line.map(|[x, y]| [x + 1.0, y - 1.0]);
+        assert!(segs.contains(&shadow), "{shadow:?} shadow drawn");
+    }
+    // Labels: each slot's number beside its A and its B line, twice (shadow).
+    let mut labels = texts(&calls);
+    labels.sort();
+    assert_eq!(labels, ["1", "1", "1", "1", "2", "2", "2", "2"]);
+    // The in-between lines are dashed.
+    assert!(calls.contains(&DrawCall::Stipple(kOfxDrawLineStipplePatternDash)));
+    assert!(take_violations().is_empty());
+}
+
+#[test]
+fn disabled_slots_and_slots_past_the_count_are_not_drawn_and_off_draws_nothing() {
+    let inst = morph();
+    two_lines(&inst);
+    inst.set_int("line2_enable", 0).unwrap();
+    inst.set_double("line3_a_start", &[700.0, 700.0], None).unwrap();
+    let ov = overlay(&inst);
+    let segs = segments(&ov.draw(0.0, (1.0, 1.0)).unwrap());
+    assert!(!segs.iter().any(|s| s[0] == [50.0, 300.0]), "slot 2 is off");
+    assert!(!segs.iter().flatten().any(|p| p[0] >= 699.0), "slot 3 is unused");
+    inst.set_choice("overlay_show", "off").unwrap();
+    assert_eq!(ov.draw(0.0, (1.0, 1.0)).unwrap(), []);
+}
+
+#[test]
+fn the_hit_radius_is_in_screen_pixels() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    // 20 canonical px right of slot 2's A end, nothing else near.
+    let pen = (50.0 + 20.0, 400.0);
+    let motion = |pixel| {
+        let before = ov.redraws();
+        ov.pen(kOfxInteractActionPenMotion, 0.0, pen, pixel).unwrap();
+        ov.redraws() - before
+    };
+    assert_eq!(motion((1.0, 1.0)), 0, "20 screen px away: nothing hovered");
+    assert_eq!(motion((4.0, 4.0)), 1, "5 screen px away: the end is hovered");
+    assert_eq!(motion((4.0, 4.0)), 0, "the same hover asks for no second redraw");
+    assert_eq!(motion((2.0, 1.0)), 1, "10 screen px in x: out of reach again");
+}
+
+#[test]
+fn a_drag_keys_only_the_grabbed_end_at_the_pen_and_is_one_undo_step() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    take_edit_log();
+    // Slot 1's A start is at (110, 100) at frame 5; drag it to (130, 90).
+    let answer = ov.drag(5.0, (111.0, 101.0), (130.0, 90.0), (1.0, 1.0)).unwrap();
+    assert_eq!(answer, Answer::Trapped);
+    assert_eq!(inst.doubles_at("line1_a_start", 5.0).unwrap(), [130.0, 90.0]);
+    // The keys at 0 and 10 stay; a third now sits at 5.
+    assert_eq!(inst.doubles_at("line1_a_start", 0.0).unwrap(), [100.0, 100.0]);
+    assert_eq!(inst.doubles_at("line1_a_start", 10.0).unwrap(), [120.0, 100.0]);
+    // Nothing else moved.
+    assert_eq!(inst.doubles_at("line1_a_end", 5.0).unwrap(), [210.0, 100.0]);
+    assert_eq!(inst.doubles_at("line1_b_start", 5.0).unwrap(), [100.0, 150.0]);
+    let log = take_edit_log();
+    assert_eq!(log.first().map(String::as_str), Some("begin Move Line 1"));
+    assert_eq!(log.last().map(String::as_str), Some("end"));
+    assert_eq!(log.iter().filter(|l| l.starts_with("begin")).count(), 1);
+    assert!(log[1..log.len() - 1].iter().all(|l| l == "set line1_a_start@5"), "{log:?}");
+    assert!(take_violations().is_empty());
+}
+
+#[test]
+fn dragging_a_middle_moves_the_whole_line_and_unkeyed_params_are_set() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    take_edit_log();
+    // Slot 2's B line (60, 300)-(60, 420): grab its middle, move by (+10, -5).
+    ov.drag(3.0, (61.0, 360.0), (71.0, 355.0), (1.0, 1.0)).unwrap();
+    assert_eq!(inst.doubles_at("line2_b_start", 0.0).unwrap(), [70.0, 295.0]);
+    assert_eq!(inst.doubles_at("line2_b_end", 99.0).unwrap(), [70.0, 415.0]);
+    let log = take_edit_log();
+    assert!(log.iter().all(|l| !l.contains('@')), "no keys made: {log:?}");
+}
+
+#[test]
+fn a_drag_in_empty_space_draws_a_new_line_into_the_next_slot() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    ov.drag(0.0, (400.0, 400.0), (500.0, 450.0), (1.0, 1.0)).unwrap();
+    let slot3 = |id: &str| inst.doubles_at(&format!("line3_{id}"), 0.0).unwrap();
+    assert_eq!(slot3("a_start"), [400.0, 400.0]);
+    assert_eq!(slot3("a_end"), [500.0, 450.0]);
+    assert_eq!(slot3("b_start"), [400.0, 400.0]);
+    assert_eq!(slot3("b_end"), [500.0, 450.0]);
+    let segs = segments(&ov.draw(0.0, (1.0, 1.0)).unwrap());
+    assert!(segs.contains(&[[400.0, 400.0], [500.0, 450.0]]));
+    // A click (no drag) makes no line.
+    ov.drag(0.0, (600.0, 600.0), (600.5, 600.0), (1.0, 1.0)).unwrap();
+    let segs = segments(&ov.draw(0.0, (1.0, 1.0)).unwrap());
+    assert!(!segs.iter().flatten().any(|p| p[0] >= 599.0));
+}
+
+#[test]
+fn pen_events_never_draw_and_unused_events_go_back_to_the_host() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    ov.draw(0.0, (1.0, 1.0)).unwrap();
+    take_violations();
+    let far = (900.0, 50.0);
+    let motion = ov.pen(kOfxInteractActionPenMotion, 0.0, far, (1.0, 1.0)).unwrap();
+    assert_eq!(motion, Answer::Default, "a motion with nothing dragged");
+    let up = ov.pen(kOfxInteractActionPenUp, 0.0, far, (1.0, 1.0)).unwrap();
+    assert_eq!(up, Answer::Default, "a pen up without a pen down");
+    let key = ov.key(kOfxInteractActionKeyDown, 0.0, 'x' as i32).unwrap();
+    assert_eq!(key, Answer::Default);
+    // Any use of the closed draw context would be a violation.
+    assert!(take_violations().is_empty());
+}
+
+#[test]
+fn delete_on_a_hovered_line_and_the_clear_button_clear_it() {
+    let inst = morph();
+    two_lines(&inst);
+    let ov = overlay(&inst);
+    ov.pen(kOfxInteractActionPenMotion, 0.0, (50.0, 350.0), (1.0, 1.0))
+        .unwrap();
+    let delete = 0xffff;
+    let answer = ov.key(kOfxInteractActionKeyDown, 0.0, delete).unwrap();
+    assert_eq!(answer, Answer::Trapped);
+    let segs = segments(&ov.draw(0.0, (1.0, 1.0)).unwrap());
+    assert!(!segs.iter().any(|s| s[0] == [50.0, 300.0]), "slot 2 cleared");
+    // Slot 1 by its button: its keys go, and the count shrinks to 0.
+    inst.instance_changed("line1_clear", 0.0).unwrap();
+    assert!(segments(&ov.draw(0.0, (1.0, 1.0)).unwrap()).is_empty());
+    // Its ends lost their keys: the same value at every time.
+    let at = |t| inst.doubles_at("line1_a_start", t).unwrap();
+    assert_eq!(at(0.0), at(10.0));
+}
+
+#[test]
+fn the_interact_is_slaved_to_the_line_params() {
+    let inst = morph();
+    let ov = overlay(&inst);
+    let slaved = ov.props().strs(kOfxInteractPropSlaveToParam);
+    for id in ["line_count", "overlay_show", "line1_a_start", "line64_b_end"] {
+        assert!(slaved.iter().any(|s| s == id), "{id}");
+    }
+}
+
+#[test]
+fn sixty_four_slots_grouped_with_a_clear_button_each() {
+    let inst = morph();
+    let names = inst.param_names();
+    for k in [1, 17, 64] {
+        for suffix in ["group", "enable", "a_start", "a_end", "b_start", "b_end", "clear"] {
+            let id = format!("line{k}_{suffix}");
+            assert!(names.iter().any(|(n, _)| *n == id), "{id}");
+        }
+    }
+    assert!(!names.iter().any(|(n, _)| n == "line65_enable"));
+}

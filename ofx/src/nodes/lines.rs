@@ -1,0 +1,113 @@
+//! The line slots as the user edits them: read at a time with their
+//! numbers, cleared, and hidden beyond Line Count.
+
+use morphfx::features::Side;
+use morphfx::geom::Vec2;
+
+use super::params::{
+    slot_clear, slot_group, slot_ids, table, Reader, LINE_COUNT, LINE_SLOTS,
+};
+use super::spec::Kind;
+use super::NodeKind;
+use crate::wrapper::params::Params;
+use crate::wrapper::Outcome;
+
+/// One enabled slot's lines at a time: A's and B's, start then end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlotLine {
+    /// The slot's number, from 1.
+    pub slot: usize,
+    /// The line on A.
+    pub a: [Vec2; 2],
+    /// The line on B.
+    pub b: [Vec2; 2],
+}
+
+impl SlotLine {
+    /// The line on `side`.
+    pub fn side(&self, side: Side) -> [Vec2; 2] {
+        match side {
+            Side::A => self.a,
+            Side::B => self.b,
+        }
+    }
+}
+
+/// The param id of slot `slot`'s end `end` (0: start, 1: end) on `side`.
+pub fn end_id(slot: usize, side: Side, end: usize) -> String {
+    let [_, a0, a1, b0, b1] = slot_ids(slot);
+    match (side, end) {
+        (Side::A, 0) => a0,
+        (Side::A, _) => a1,
+        (Side::B, 0) => b0,
+        (Side::B, _) => b1,
+    }
+}
+
+/// The enabled slots up to Line Count whose ends are all finite, even
+/// zero-length ones (a line being drawn starts with no length).
+pub fn slot_lines(r: &Reader<'_>) -> Vec<SlotLine> {
+    let mut lines = Vec::new();
+    for k in 1..=(r.int(LINE_COUNT).max(0) as usize).min(LINE_SLOTS) {
+        let [enable, a0, a1, b0, b1] = slot_ids(k);
+        if !r.bool(&enable) {
+            continue;
+        }
+        let ends = [&a0, &a1, &b0, &b1].map(|id| r.point(id));
+        if let [Some(a0), Some(a1), Some(b0), Some(b1)] = ends {
+            if [a0, a1, b0, b1].iter().all(|p| p.is_finite()) {
+                lines.push(SlotLine {
+                    slot: k,
+                    a: [a0, a1],
+                    b: [b0, b1],
+                });
+            }
+        }
+    }
+    lines
+}
+
+/// Clears slot `k`: its ends lose their keys and go back to their
+/// defaults, and it is turned off; a trailing run of disabled slots leaves
+/// Line Count. One undo step.
+pub fn clear(kind: NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
+    let [enable, ..] = slot_ids(k);
+    params.edit_block(&format!("Clear Line {k}"), || {
+        for side in [Side::A, Side::B] {
+            for end in 0..2 {
+                let id = end_id(k, side, end);
+                params.delete_all_keys(&id)?;
+                params.set_point(&id, default_point(kind, &id))?;
+            }
+        }
+        params.set_int(&enable, 0)?;
+        let r = Reader::new(params, kind, time);
+        let mut count = r.int(LINE_COUNT).max(0) as usize;
+        while count > 0 && !r.bool(&slot_ids(count)[0]) {
+            count -= 1;
+        }
+        params.set_int(LINE_COUNT, count as i32)
+    })?;
+    hide_unused(kind, params, time);
+    Ok(())
+}
+
+fn default_point(kind: NodeKind, id: &str) -> (f64, f64) {
+    match table(kind).iter().find(|p| p.id == id).map(|p| &p.kind) {
+        Some(Kind::Point { default }) => *default,
+        _ => (0.0, 0.0),
+    }
+}
+
+/// Shows the slots up to Line Count and hides the rest. Best effort: a
+/// host that cannot hide params shows them all, which is only untidy.
+pub fn hide_unused(kind: NodeKind, params: &Params, time: f64) {
+    let count = Reader::new(params, kind, time).int(LINE_COUNT).max(0) as usize;
+    for k in 1..=LINE_SLOTS {
+        let secret = k > count;
+        let _ = params.set_secret(&slot_group(k), secret);
+        for id in slot_ids(k).iter().chain([&slot_clear(k)]) {
+            let _ = params.set_secret(id, secret);
+        }
+    }
+}

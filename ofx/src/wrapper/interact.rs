@@ -1,0 +1,230 @@
+//! The overlay interact's entry points: the same door discipline as
+//! [`super::dispatch`] (null checks, unwinds caught, statuses mapped), the
+//! host's interact arguments read into safe values, and the painter chosen:
+//! the Draw suite when the draw action carries a context, else OpenGL.
+
+use std::ffi::{c_char, c_void, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use morphfx::geom::Vec2;
+use openfx::sys::generic::core::*;
+use openfx::sys::image_effect_v1::draw_suite::*;
+use openfx::sys::image_effect_v1::key_syms::kOfxPropKeySym;
+use openfx::sys::image_effect_v1::interact::*;
+
+use super::clips::Effect;
+use super::draw::DrawSuitePainter;
+use super::gl::GlPainter;
+use super::props::PropSet;
+use super::{host, Failure, Outcome, Reply};
+use crate::nodes::overlay::{self, Pen};
+use crate::nodes::NodeKind;
+
+macro_rules! entry {
+    ($name:ident, $kind:expr) => {
+        unsafe extern "C" fn $name(
+            action: *const c_char,
+            handle: *const c_void,
+            in_args: OfxPropertySetHandle,
+            out_args: OfxPropertySetHandle,
+        ) -> OfxStatus {
+            let _ = out_args; // interacts have none
+            // SAFETY: the host calls an interact entry point with an
+            // action's arguments, which is `dispatch`'s contract.
+            unsafe { dispatch($kind, action, handle, in_args) }
+        }
+    };
+}
+entry!(morph_overlay, NodeKind::Morph);
+entry!(warp_overlay, NodeKind::Warp);
+
+/// The overlay entry point of a `kind` node, for the effect descriptor.
+pub fn entry(kind: NodeKind) -> *mut c_void {
+    let f: OfxPluginEntryPoint = match kind {
+        NodeKind::Morph => morph_overlay,
+        NodeKind::Warp => warp_overlay,
+    };
+    f as *mut c_void
+}
+
+type OfxPluginEntryPoint = unsafe extern "C" fn(
+    *const c_char,
+    *const c_void,
+    OfxPropertySetHandle,
+    OfxPropertySetHandle,
+) -> OfxStatus;
+
+/// Runs one interact action.
+///
+/// # Safety
+/// `action` null or NUL-terminated; `handle` null or the interact handle
+/// of the action; `in_args` null or the action's property set; all valid
+/// until this call returns, as OFX promises of every host.
+unsafe fn dispatch(
+    kind: NodeKind,
+    action: *const c_char,
+    handle: *const c_void,
+    in_args: OfxPropertySetHandle,
+) -> OfxStatus {
+    if action.is_null() || handle.is_null() {
+        return kOfxStatErrBadHandle;
+    }
+    // SAFETY: non-null and NUL-terminated (the host's action name).
+    let action = unsafe { CStr::from_ptr(action) };
+    let interact = handle as OfxInteractHandle;
+    let in_args = (!in_args.is_null()).then(|| {
+        // SAFETY: the action's in-args, per this function's contract.
+        unsafe { PropSet::from_raw(in_args) }
+    });
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let in_args = in_args.transpose()?;
+        // SAFETY: `interact` is the action's interact handle.
+        unsafe { run(kind, action, interact, in_args) }
+    }));
+    match result {
+        Ok(Ok(Reply::Done)) => kOfxStatOK,
+        Ok(Ok(Reply::Default)) => kOfxStatReplyDefault,
+        Ok(Err(failure)) => {
+            let _ = catch_unwind(|| {
+                eprintln!(
+                    "MorphFX overlay: {}: {}",
+                    action.to_string_lossy(),
+                    failure.message()
+                )
+            });
+            failure.status()
+        }
+        Err(_) => kOfxStatFailed,
+    }
+}
+
+/// # Safety
+/// `interact` is the live interact handle of the action.
+unsafe fn run(
+    kind: NodeKind,
+    action: &CStr,
+    interact: OfxInteractHandle,
+    in_args: Option<PropSet>,
+) -> Outcome<Reply> {
+    let suite = host::suites()?
+        .interact
+        .ok_or_else(|| Failure::Failed("host has no interact suite".into()))?;
+    if action == kOfxActionDescribe || action == kOfxActionDestroyInstance {
+        return Ok(Reply::Done);
+    }
+    // SAFETY: the caller's interact handle.
+    let props = unsafe { props_of(suite, interact)? };
+    if action == kOfxActionCreateInstance {
+        // Redraw when any line param changes.
+        let ids = overlay::slave_params();
+        let _ = props.set_strings(
+            kOfxInteractPropSlaveToParam,
+            &ids.iter().map(String::as_str).collect::<Vec<_>>(),
+        );
+        return Ok(Reply::Done);
+    }
+    let args = in_args.ok_or_else(|| {
+        Failure::Status(kOfxStatErrBadHandle, "interact action without in-args".into())
+    })?;
+    let effect = effect_of(&args, &props)?;
+    let time = args.get_double(kOfxPropTime, 0)?;
+    if action == kOfxInteractActionDraw {
+        // SAFETY: `args` are the draw action's, read during it.
+        return unsafe { draw(kind, &effect, &args, time) };
+    }
+    if action == kOfxInteractActionKeyDown || action == kOfxInteractActionKeyRepeat {
+        let sym = args.get_int(kOfxPropKeySym, 0)?;
+        return overlay::key_down(kind, &effect, sym, time);
+    }
+    if action == kOfxInteractActionKeyUp {
+        return overlay::key_up(&effect, args.get_int(kOfxPropKeySym, 0)?);
+    }
+    if action == kOfxInteractActionLoseFocus {
+        return overlay::lose_focus(&effect);
+    }
+    let pen = || -> Outcome<Pen> {
+        let [x, y] = args.get_doubles::<2>(kOfxInteractPropPenPosition)?;
+        Ok(Pen {
+            time,
+            at: Vec2::new(x, y),
+            pixel: pixel_scale(&args),
+        })
+    };
+    if action == kOfxInteractActionPenDown {
+        overlay::pen_down(kind, &effect, pen()?)
+    } else if action == kOfxInteractActionPenMotion {
+        let mut redraw = || {
+            if let Some(f) = suite.interactRedraw {
+                // SAFETY: the live interact handle.
+                unsafe { f(interact) };
+            }
+        };
+        overlay::pen_motion(kind, &effect, pen()?, &mut redraw)
+    } else if action == kOfxInteractActionPenUp {
+        overlay::pen_up(kind, &effect, pen()?)
+    } else {
+        Ok(Reply::Default)
+    }
+}
+
+/// # Safety
+/// `interact` is a live interact handle.
+unsafe fn props_of(suite: &OfxInteractSuiteV1, interact: OfxInteractHandle) -> Outcome<PropSet> {
+    let get = suite
+        .interactGetPropertySet
+        .ok_or_else(|| Failure::Failed("host has no interactGetPropertySet".into()))?;
+    let mut props: OfxPropertySetHandle = std::ptr::null_mut();
+    // SAFETY: the live handle and an out-pointer on our stack.
+    super::check(unsafe { get(interact, &mut props) }, "interactGetPropertySet")?;
+    // SAFETY: the host's property set of the interact, live as long as it.
+    unsafe { PropSet::from_raw(props) }
+}
+
+/// The effect the interact belongs to: named in the action's arguments,
+/// or in the interact's own properties.
+fn effect_of(args: &PropSet, props: &PropSet) -> Outcome<Effect> {
+    let handle = args
+        .get_pointer(kOfxPropEffectInstance, 0)
+        .ok()
+        .filter(|p| !p.is_null())
+        .or_else(|| props.get_pointer(kOfxPropEffectInstance, 0).ok())
+        .filter(|p| !p.is_null())
+        .ok_or_else(|| {
+            Failure::Status(kOfxStatErrBadHandle, "interact without its effect".into())
+        })?;
+    // SAFETY: the host names the interact's effect instance, which
+    // outlives its interacts (OFX: an interact is bound to one instance).
+    unsafe { Effect::from_raw(handle) }
+}
+
+/// Canonical units per screen pixel as the host says (1, 1 when it does not).
+fn pixel_scale(args: &PropSet) -> (f64, f64) {
+    match args.get_doubles::<2>(kOfxInteractPropPixelScale) {
+        Ok([x, y]) if x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite() => (x, y),
+        _ => (1.0, 1.0),
+    }
+}
+
+/// # Safety
+/// `args` are the running draw action's arguments.
+unsafe fn draw(kind: NodeKind, effect: &Effect, args: &PropSet, time: f64) -> Outcome<Reply> {
+    let pixel = pixel_scale(args);
+    let context = args
+        .get_pointer(kOfxInteractPropDrawContext, 0)
+        .ok()
+        .filter(|p| !p.is_null());
+    if let (Some(context), Some(suite)) = (context, host::suites()?.draw) {
+        // SAFETY: the draw action's own context, used only during it.
+        let mut painter = unsafe { DrawSuitePainter::new(suite, context as OfxDrawContextHandle) };
+        return overlay::draw(kind, effect, time, pixel, &mut painter);
+    }
+    match GlPainter::new(pixel) {
+        Some(mut painter) => {
+            let measured = painter.pixel();
+            overlay::measured_pixel(effect, measured)?;
+            overlay::draw(kind, effect, time, measured, &mut painter)
+        }
+        // No Draw suite and no GL context: nothing to draw with.
+        None => Ok(Reply::Done),
+    }
+}
