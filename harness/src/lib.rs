@@ -3,5 +3,6 @@
 
 pub mod host;
 pub mod io;
+pub mod raster;
 pub mod sequence;
 pub mod snap;

@@ -10,8 +10,9 @@ use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx::scene::Scene;
 use morphfx::snake::SnakeSettings;
+use morphfx_harness::host::overlay::Overlay;
 use morphfx_harness::host::{
-    Bundle, ErrorKind, Frame, FrameSource, HostError, Instance, OutputSpec,
+    Bundle, ErrorKind, Frame, FrameSource, HostError, HostOptions, Instance, OutputSpec,
 };
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 use morphfx_harness::sequence::{frame_path, is_sequence, parse_frames};
@@ -102,6 +103,23 @@ enum Command {
     Demo {
         #[arg(short = 'o', long = "output", default_value = "morphfx-demo")]
         output: PathBuf,
+    },
+    /// Draw the node's viewer overlay (its line slots and the scene's
+    /// features) over the plates, as a host's viewer shows them.
+    Overlay {
+        #[command(flatten)]
+        common: Common,
+        /// Source A (with --b: the Morph node's overlay).
+        #[arg(long, conflicts_with = "input")]
+        a: Option<String>,
+        #[arg(long, requires = "a")]
+        b: Option<String>,
+        /// The source of the Warp node's overlay.
+        #[arg(long)]
+        input: Option<String>,
+        /// a, b, both or between: which lines, on which plate (B's for b).
+        #[arg(long, default_value = "both")]
+        show: String,
     },
     /// List the plugins in the bundle.
     Plugins,
@@ -194,6 +212,13 @@ fn run(cli: Cli) -> Result<(), HostError> {
             job.run(&bundle_path()?)
         }
         Command::Demo { output } => demo(&bundle_path()?, &output),
+        Command::Overlay {
+            common,
+            a,
+            b,
+            input,
+            show,
+        } => overlay_job(common, a, b, input)?.run_overlay(&bundle_path()?, &show),
         Command::Snap {
             scene,
             a,
@@ -240,6 +265,32 @@ fn list_plugins(bundle_path: &Path) -> Result<(), HostError> {
         println!("{}\t{}.{}\t{served_by}", p.id, p.version.0, p.version.1);
     }
     Ok(())
+}
+
+/// `morphfx overlay`: the Morph node's overlay with A and B, else the Warp
+/// node's with its input.
+fn overlay_job(
+    common: Common,
+    a: Option<String>,
+    b: Option<String>,
+    input: Option<String>,
+) -> Result<Job, HostError> {
+    match (a, b, input) {
+        (Some(a), Some(b), None) => {
+            morph_job(common, a, b, [None, None], "morph".into(), "general")
+        }
+        (None, None, Some(input)) => Ok(Job {
+            plugin: WARP_ID,
+            context: "OfxImageEffectContextFilter",
+            sources: vec![("Source".to_owned(), input)],
+            view: "warped".into(),
+            extra: Vec::new(),
+            common,
+        }),
+        _ => Err(HostError::bad(
+            "overlay needs --a and --b (Morph) or --input (Warp)",
+        )),
+    }
 }
 
 /// `morphfx morph`: the morph node in the general or transition context.
@@ -401,6 +452,30 @@ impl LineKey {
     }
 }
 
+/// The Show Lines option `--show` names.
+fn show_option(show: &str) -> Result<&'static str, HostError> {
+    Ok(match show {
+        "both" => "A and B",
+        "a" => "A only",
+        "b" => "B only",
+        "between" => "in-between",
+        other => {
+            return Err(HostError::bad(format!(
+                "--show {other}: expected a, b, both or between"
+            )))
+        }
+    })
+}
+
+/// What a job reads before it loads the bundle.
+struct Prepared {
+    scene: Option<Scene>,
+    lines: Vec<LineKey>,
+    frames: Vec<i64>,
+    plates: Vec<(String, Arc<Plates>)>,
+    inputs: Inputs,
+}
+
 struct Job {
     plugin: &'static str,
     context: &'static str,
@@ -413,6 +488,31 @@ struct Job {
 
 impl Job {
     fn run(&self, bundle_path: &Path) -> Result<(), HostError> {
+        let job = self.prepare()?;
+        let bundle = Bundle::load(bundle_path)?;
+        let inst = bundle.instance(self.plugin, self.context)?;
+        self.set_up(&inst, &job.lines, &job.plates, job.inputs.size)?;
+        let scene = job.scene.as_ref();
+        self.render_frames(&inst, &job.frames, &job.plates, scene, &job.inputs)
+    }
+
+    /// `morphfx overlay`: the plugin's overlay drawn over the plates.
+    fn run_overlay(&self, bundle_path: &Path, show: &str) -> Result<(), HostError> {
+        show_option(show)?;
+        let job = self.prepare()?;
+        let options = HostOptions {
+            overlays: true,
+            draw_suite: true,
+        };
+        let bundle = Bundle::load_with(bundle_path, options)?;
+        let inst = bundle.instance(self.plugin, self.context)?;
+        self.set_up(&inst, &job.lines, &job.plates, job.inputs.size)?;
+        self.draw_overlays(&inst, &job, show)
+    }
+
+    /// Everything a run reads before it loads the bundle: the scene, the
+    /// lines, the frames and every input's header.
+    fn prepare(&self) -> Result<Prepared, HostError> {
         let c = &self.common;
         let scene = read_scene(c.scene.as_deref())?;
         let lines = c
@@ -432,10 +532,45 @@ impl Job {
             .map(|(clip, p)| (clip.clone(), Plates::new(p)))
             .collect();
         let inputs = check_inputs(&plates, &frames)?;
-        let bundle = Bundle::load(bundle_path)?;
-        let inst = bundle.instance(self.plugin, self.context)?;
-        self.set_up(&inst, &lines, &plates, inputs.size)?;
-        self.render_frames(&inst, &frames, &plates, scene.as_ref(), &inputs)
+        Ok(Prepared {
+            scene,
+            lines,
+            frames,
+            plates,
+            inputs,
+        })
+    }
+
+    /// Each frame's plate (B's with `--show b`, else the first source's)
+    /// with the overlay drawn on it, written where the output says.
+    fn draw_overlays(
+        &self,
+        inst: &Instance<'_>,
+        job: &Prepared,
+        show: &str,
+    ) -> Result<(), HostError> {
+        inst.set_choice("overlay_show", show_option(show)?)?;
+        let source = match (show, self.sources.get(1)) {
+            ("b", Some((_, b))) => b,
+            _ => &self.sources[0].1,
+        };
+        let overlay = Overlay::new(inst, true)?
+            .ok_or_else(|| HostError::failed("the plugin declares no overlay"))?;
+        let precision = if self.common.half || (job.inputs.half && !self.common.float) {
+            ExrPrecision::Half
+        } else {
+            ExrPrecision::Float
+        };
+        let progress = Progress::new(job.frames.len());
+        for (n, &f) in job.frames.iter().enumerate() {
+            let mut plate = io::read(&frame_path(source, f))?;
+            let calls = overlay.draw(f as f64, (1.0, 1.0))?;
+            morphfx_harness::raster::paint(&mut plate.image, &calls, (1.0, 1.0));
+            io::write(&frame_path(&self.common.output, f), &plate, precision)?;
+            progress.tick(n + 1, f);
+        }
+        progress.done("overlays drawn");
+        Ok(())
     }
 
     /// The frames to render: `--frames`, else the one frame the scene or

@@ -19,14 +19,18 @@ fn without_a_draw_suite_or_gl_context_draw_is_a_no_op_and_editing_works() {
         .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
         .unwrap();
     // No V2 entry: this host offers no Draw suite.
-    let v2 = inst.descriptor_props().get("OfxImageEffectPluginPropOverlayInteractV2");
+    let v2 = inst
+        .descriptor_props()
+        .get("OfxImageEffectPluginPropOverlayInteractV2");
     assert!(v2.is_none(), "{v2:?}");
     inst.set_int("line_count", 1).unwrap();
-    inst.set_double("line1_a_start", &[10.0, 10.0], None).unwrap();
+    inst.set_double("line1_a_start", &[10.0, 10.0], None)
+        .unwrap();
     inst.set_double("line1_a_end", &[90.0, 10.0], None).unwrap();
     let ov = Overlay::new(&inst, false).unwrap().expect("a V1 overlay");
     assert_eq!(ov.draw(0.0, (1.0, 1.0)).unwrap(), []);
-    ov.drag(0.0, (90.0, 10.0), (95.0, 40.0), (1.0, 1.0)).unwrap();
+    ov.drag(0.0, (90.0, 10.0), (95.0, 40.0), (1.0, 1.0))
+        .unwrap();
     assert_eq!(inst.doubles_at("line1_a_end", 0.0).unwrap(), [95.0, 40.0]);
     assert!(take_violations().is_empty());
 }

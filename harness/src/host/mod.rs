@@ -149,7 +149,10 @@ unsafe extern "C" fn fetch_suite(
             &services::PROGRESS_SUITE_V2 as *const _ as *const c_void
         }
         (n, 1) if n == kOfxTimeLineSuite => &services::TIME_LINE_SUITE as *const _ as *const c_void,
-        (n, 1) if n == overlay::kOfxInteractSuite && offers(host, kOfxImageEffectPropSupportsOverlays) => {
+        (n, 1)
+            if n == overlay::kOfxInteractSuite
+                && offers(host, kOfxImageEffectPropSupportsOverlays) =>
+        {
             &overlay::INTERACT_SUITE as *const _ as *const c_void
         }
         (n, 1) if n == overlay::kOfxDrawSuite && offers(host, overlay::DRAW_SUITE_PROP) => {
@@ -251,7 +254,10 @@ fn host_properties(options: HostOptions) -> Box<PropertySet> {
     host_props.set_str(kOfxPropName, "net.morphfx.harness");
     host_props.set_str(kOfxPropLabel, "morphfx harness");
     host_props.set_int(kOfxImageEffectHostPropIsBackground, &[1]);
-    host_props.set_int(kOfxImageEffectPropSupportsOverlays, &[options.overlays as i32]);
+    host_props.set_int(
+        kOfxImageEffectPropSupportsOverlays,
+        &[options.overlays as i32],
+    );
     host_props.set_int(overlay::DRAW_SUITE_PROP, &[options.draw_suite as i32]);
     host_props.set_int(kOfxImageEffectPropSupportsMultiResolution, &[1]);
     host_props.set_int(kOfxImageEffectPropSupportsTiles, &[1]);

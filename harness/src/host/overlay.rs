@@ -7,11 +7,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use openfx::sys::generic::core::*;
-use openfx::sys::image_effect_v1::draw_suite::*;
 pub use openfx::sys::image_effect_v1::draw_suite::kOfxDrawSuite;
+use openfx::sys::image_effect_v1::draw_suite::*;
 use openfx::sys::image_effect_v1::image_effect::*;
-use openfx::sys::image_effect_v1::interact::*;
 pub use openfx::sys::image_effect_v1::interact::kOfxInteractSuite;
+use openfx::sys::image_effect_v1::interact::*;
 use openfx::sys::image_effect_v1::key_syms::kOfxPropKeySym;
 use openfx::sys::image_effect_v1::pixels::OfxRGBAColourF;
 
@@ -68,7 +68,9 @@ unsafe fn context<'a>(h: OfxDrawContextHandle, what: &str) -> Option<&'a Context
     // SAFETY: per the contract.
     let c = unsafe { (h as *const Context).as_ref() }?;
     if !c.open.load(Ordering::Acquire) {
-        violation(format!("{what} on a draw context after its draw action returned"));
+        violation(format!(
+            "{what} on a draw context after its draw action returned"
+        ));
         return None;
     }
     Some(c)
@@ -136,7 +138,7 @@ unsafe extern "C" fn set_stipple(
 /// Whether `n` points make a `primitive` (the OpenGL rules the suite names).
 pub fn valid_count(primitive: OfxDrawPrimitive, n: usize) -> bool {
     if primitive == kOfxDrawPrimitiveLines {
-        n >= 2 && n % 2 == 0
+        n >= 2 && n.is_multiple_of(2)
     } else if primitive == kOfxDrawPrimitiveLineStrip || primitive == kOfxDrawPrimitiveLineLoop {
         n >= 2
     } else if primitive == kOfxDrawPrimitiveRectangle || primitive == kOfxDrawPrimitiveEllipse {
@@ -261,6 +263,8 @@ pub struct Overlay<'i> {
     _descriptor: Box<Interact>,
     interact: Box<Interact>,
     /// Every draw context ever handed out: kept, so a late use is seen.
+    /// Boxed: the plugin holds their addresses, which must not move.
+    #[allow(clippy::vec_box)]
     contexts: Mutex<Vec<Box<Context>>>,
     draw_suite: bool,
 }
@@ -296,7 +300,10 @@ impl<'i> Overlay<'i> {
         descriptor.props.set_int(kOfxInteractPropBitDepth, &[8]);
         let interact = new_interact();
         let p = &interact.props;
-        p.set_ptr(kOfxPropEffectInstance, instance.effect.handle() as *mut c_void);
+        p.set_ptr(
+            kOfxPropEffectInstance,
+            instance.effect.handle() as *mut c_void,
+        );
         p.set_double(kOfxInteractPropPixelScale, &[1.0, 1.0]);
         p.set_double(kOfxInteractPropBackgroundColour, &[0.0, 0.0, 0.0]);
         p.set_int(kOfxInteractPropHasAlpha, &[1]);
@@ -352,7 +359,10 @@ impl<'i> Overlay<'i> {
 
     fn args(&self, time: f64, pixel: (f64, f64)) -> PropertySet {
         let a = PropertySet::new();
-        a.set_ptr(kOfxPropEffectInstance, self.instance.effect.handle() as *mut c_void);
+        a.set_ptr(
+            kOfxPropEffectInstance,
+            self.instance.effect.handle() as *mut c_void,
+        );
         a.set_double(kOfxInteractPropPixelScale, &[pixel.0, pixel.1]);
         a.set_double(kOfxInteractPropBackgroundColour, &[0.0, 0.0, 0.0]);
         a.set_double(kOfxPropTime, &[time]);
@@ -369,7 +379,10 @@ impl<'i> Overlay<'i> {
             open: AtomicBool::new(true),
         });
         if self.draw_suite {
-            a.set_ptr(kOfxInteractPropDrawContext, &*context as *const Context as *mut c_void);
+            a.set_ptr(
+                kOfxInteractPropDrawContext,
+                &*context as *const Context as *mut c_void,
+            );
         }
         let result = self.call(kOfxInteractActionDraw, Some(&a));
         context.open.store(false, Ordering::Release);
@@ -401,7 +414,10 @@ impl<'i> Overlay<'i> {
     pub fn key(&self, action: &CStr, time: f64, sym: i32) -> Result<Answer, HostError> {
         let a = self.args(time, (1.0, 1.0));
         a.set_int(kOfxPropKeySym, &[sym]);
-        a.set_str(openfx::sys::image_effect_v1::key_syms::kOfxPropKeyString, "");
+        a.set_str(
+            openfx::sys::image_effect_v1::key_syms::kOfxPropKeyString,
+            "",
+        );
         self.call(action, Some(&a))
     }
 

@@ -4,9 +4,7 @@
 use morphfx::features::Side;
 use morphfx::geom::Vec2;
 
-use super::params::{
-    slot_clear, slot_group, slot_ids, table, Reader, LINE_COUNT, LINE_SLOTS,
-};
+use super::params::{slot_clear, slot_group, slot_ids, table, Reader, LINE_COUNT, LINE_SLOTS};
 use super::spec::Kind;
 use super::NodeKind;
 use crate::wrapper::params::Params;

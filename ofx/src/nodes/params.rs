@@ -76,7 +76,11 @@ pub fn slot_clear(k: usize) -> String {
 
 /// The slot whose Clear Line button `id` is.
 pub fn clear_button_slot(id: &str) -> Option<usize> {
-    let k: usize = id.strip_prefix("line")?.strip_suffix("_clear")?.parse().ok()?;
+    let k: usize = id
+        .strip_prefix("line")?
+        .strip_suffix("_clear")?
+        .parse()
+        .ok()?;
     (1..=LINE_SLOTS).contains(&k).then_some(k)
 }
 

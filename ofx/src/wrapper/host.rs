@@ -6,8 +6,8 @@ use std::sync::RwLock;
 
 use openfx::sys::generic::core::*;
 use openfx::sys::generic::property::*;
-use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::draw_suite::*;
+use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::interact::*;
 use openfx::sys::image_effect_v1::message::*;
 use openfx::sys::image_effect_v1::param::*;

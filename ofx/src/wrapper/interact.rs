@@ -9,8 +9,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use morphfx::geom::Vec2;
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::draw_suite::*;
-use openfx::sys::image_effect_v1::key_syms::kOfxPropKeySym;
 use openfx::sys::image_effect_v1::interact::*;
+use openfx::sys::image_effect_v1::key_syms::kOfxPropKeySym;
 
 use super::clips::Effect;
 use super::draw::DrawSuitePainter;
@@ -29,8 +29,8 @@ macro_rules! entry {
             out_args: OfxPropertySetHandle,
         ) -> OfxStatus {
             let _ = out_args; // interacts have none
-            // SAFETY: the host calls an interact entry point with an
-            // action's arguments, which is `dispatch`'s contract.
+                              // SAFETY: the host calls an interact entry point with an
+                              // action's arguments, which is `dispatch`'s contract.
             unsafe { dispatch($kind, action, handle, in_args) }
         }
     };
@@ -124,7 +124,10 @@ unsafe fn run(
         return Ok(Reply::Done);
     }
     let args = in_args.ok_or_else(|| {
-        Failure::Status(kOfxStatErrBadHandle, "interact action without in-args".into())
+        Failure::Status(
+            kOfxStatErrBadHandle,
+            "interact action without in-args".into(),
+        )
     })?;
     let effect = effect_of(&args, &props)?;
     let time = args.get_double(kOfxPropTime, 0)?;
@@ -175,7 +178,8 @@ unsafe fn props_of(suite: &OfxInteractSuiteV1, interact: OfxInteractHandle) -> O
         .ok_or_else(|| Failure::Failed("host has no interactGetPropertySet".into()))?;
     let mut props: OfxPropertySetHandle = std::ptr::null_mut();
     // SAFETY: the live handle and an out-pointer on our stack.
-    super::check(unsafe { get(interact, &mut props) }, "interactGetPropertySet")?;
+    let status = unsafe { get(interact, &mut props) };
+    super::check(status, "interactGetPropertySet")?;
     // SAFETY: the host's property set of the interact, live as long as it.
     unsafe { PropSet::from_raw(props) }
 }

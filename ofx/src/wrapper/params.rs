@@ -383,7 +383,10 @@ impl Params {
         };
         let label = cstr(name);
         // SAFETY: the instance's param set and a NUL-terminated label.
-        check(unsafe { begin(self.set.set, label.as_ptr()) }, "paramEditBegin")
+        check(
+            unsafe { begin(self.set.set, label.as_ptr()) },
+            "paramEditBegin",
+        )
     }
 
     /// Closes the block [`Params::begin_edit`] opened.

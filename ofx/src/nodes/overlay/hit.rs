@@ -83,7 +83,10 @@ mod tests {
         assert_eq!((h.slot, h.side, h.part), (3, Side::A, Part::Start));
         let h = hit(&s, Vec2::new(150.0, 296.0), (1.0, 1.0), &both).unwrap();
         assert_eq!((h.side, h.part), (Side::B, Part::Middle));
-        assert_eq!(hit(&s, Vec2::new(150.0, 296.0), (1.0, 1.0), &[Side::A]), None);
+        assert_eq!(
+            hit(&s, Vec2::new(150.0, 296.0), (1.0, 1.0), &[Side::A]),
+            None
+        );
         assert_eq!(hit(&s, Vec2::new(150.0, 200.0), (1.0, 1.0), &both), None);
     }
 

@@ -17,8 +17,7 @@ use paint::{Frame, Painter};
 
 use super::lines::{self, end_id, slot_lines, SlotLine};
 use super::params::{
-    slot_ids, EditSides, Reader, Settings, Show, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT,
-    OVERLAY_SHOW,
+    slot_ids, EditSides, Reader, Settings, Show, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT, OVERLAY_SHOW,
 };
 use super::render::{context, warp_inputs};
 use super::{instance, NodeKind};
@@ -117,10 +116,7 @@ pub fn draw(
         }
         Err(_) => (Vec::new(), settings.progress),
     };
-    let between: Vec<[Vec2; 2]> = slots
-        .iter()
-        .map(|l| in_between(l, t, &settings))
-        .collect();
+    let between: Vec<[Vec2; 2]> = slots.iter().map(|l| in_between(l, t, &settings)).collect();
     let hover = lock(&instance.overlay).hover;
     paint::paint(
         painter,
@@ -233,11 +229,7 @@ pub fn pen_down(kind: NodeKind, effect: &Effect, pen: Pen) -> Outcome<Reply> {
 fn write_drag(params: &Params, drag: Drag, pen: Pen) -> Outcome {
     let xy = |p: Vec2| (p.x, p.y);
     match drag {
-        Drag::Move {
-            handle,
-            from,
-            ends,
-        } => {
+        Drag::Move { handle, from, ends } => {
             let id = |end| end_id(handle.slot, handle.side, end);
             match handle.part {
                 Part::Start => params.move_point(&id(0), pen.time, xy(pen.at)),

@@ -192,7 +192,8 @@ impl Pen<'_> {
         for (side, colour) in sides(frame.show) {
             for l in frame.slots {
                 let hovered = frame.hover.filter(|h| h.slot == l.slot && h.side == side);
-                self.painter.width(if hovered.is_some() { 3.0 } else { 1.5 });
+                self.painter
+                    .width(if hovered.is_some() { 3.0 } else { 1.5 });
                 self.colour(colour, 1.0);
                 let line = l.side(side);
                 self.arrow(line);
@@ -212,7 +213,13 @@ impl Pen<'_> {
             Part::Middle => return,
         };
         let (dx, dy) = (self.screen(HANDLE_PX, 0.0), self.screen(0.0, HANDLE_PX));
-        let pts = [c - dx - dy, c + dx - dy, c + dx + dy, c - dx + dy, c - dx - dy];
+        let pts = [
+            c - dx - dy,
+            c + dx - dy,
+            c + dx + dy,
+            c - dx + dy,
+            c - dx - dy,
+        ];
         let pts = pts.map(|p| self.at(p));
         self.painter.strip(&pts);
     }
