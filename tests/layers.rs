@@ -9,7 +9,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("geom", 0),
     ("choice", 0),
-    ("strokes", 0),
+    ("strokes", 1),
     ("features", 1),
     ("bspline", 1),
     ("image", 1),

@@ -775,6 +775,11 @@ mod tests {
         ),
         (FILTER, &["bilinear", "bicubic"]),
         (EDGE, &["clamp", "black", "mirror"]),
+        (
+            OVERLAY_SHOW,
+            &["A and B", "A only", "B only", "in-between", "off"],
+        ),
+        (OVERLAY_EDIT, &["A and B", "A only", "B only"]),
     ];
 
     fn released() -> Vec<(NodeKind, &'static str, &'static [&'static str])> {

@@ -1,7 +1,7 @@
 //! The three symbols a host looks up, written by hand: `OfxSetHost` must return
 //! an `OfxStatus` (the `openfx` crate's export macro gets this wrong).
 
-use std::ffi::{c_char, c_int, c_void, CString};
+use std::ffi::{c_int, CString};
 use std::sync::OnceLock;
 
 use openfx::sys::generic::core::*;
@@ -26,22 +26,8 @@ unsafe impl Sync for Statics {}
 
 static STATICS: OnceLock<Statics> = OnceLock::new();
 
-macro_rules! entry {
-    ($name:ident, $kind:expr) => {
-        unsafe extern "C" fn $name(
-            action: *const c_char,
-            handle: *const c_void,
-            in_args: OfxPropertySetHandle,
-            out_args: OfxPropertySetHandle,
-        ) -> OfxStatus {
-            // SAFETY: the host calls this entry point with an action's
-            // arguments, which is `dispatch`'s contract.
-            unsafe { dispatch($kind, action, handle, in_args, out_args) }
-        }
-    };
-}
-entry!(morph_main, NodeKind::Morph);
-entry!(warp_main, NodeKind::Warp);
+entry_point!(morph_main, NodeKind::Morph, dispatch);
+entry_point!(warp_main, NodeKind::Warp, dispatch);
 
 unsafe extern "C" fn set_host_v1(host: *mut OfxHost) {
     let _ = std::panic::catch_unwind(|| host::set_host(host));

@@ -20,23 +20,8 @@ use super::{host, Failure, Outcome, Reply};
 use crate::nodes::overlay::{self, Pen};
 use crate::nodes::NodeKind;
 
-macro_rules! entry {
-    ($name:ident, $kind:expr) => {
-        unsafe extern "C" fn $name(
-            action: *const c_char,
-            handle: *const c_void,
-            in_args: OfxPropertySetHandle,
-            out_args: OfxPropertySetHandle,
-        ) -> OfxStatus {
-            let _ = out_args; // interacts have none
-                              // SAFETY: the host calls an interact entry point with an
-                              // action's arguments, which is `dispatch`'s contract.
-            unsafe { dispatch($kind, action, handle, in_args) }
-        }
-    };
-}
-entry!(morph_overlay, NodeKind::Morph);
-entry!(warp_overlay, NodeKind::Warp);
+entry_point!(morph_overlay, NodeKind::Morph, dispatch);
+entry_point!(warp_overlay, NodeKind::Warp, dispatch);
 
 /// The overlay entry point of a `kind` node, for the effect descriptor.
 pub fn entry(kind: NodeKind) -> *mut c_void {
@@ -59,12 +44,14 @@ type OfxPluginEntryPoint = unsafe extern "C" fn(
 /// # Safety
 /// `action` null or NUL-terminated; `handle` null or the interact handle
 /// of the action; `in_args` null or the action's property set; all valid
-/// until this call returns, as OFX promises of every host.
+/// until this call returns, as OFX promises of every host. Interacts have
+/// no out-args.
 unsafe fn dispatch(
     kind: NodeKind,
     action: *const c_char,
     handle: *const c_void,
     in_args: OfxPropertySetHandle,
+    _out_args: OfxPropertySetHandle,
 ) -> OfxStatus {
     if action.is_null() || handle.is_null() {
         return kOfxStatErrBadHandle;

@@ -2,6 +2,24 @@
 //! entry point goes through [`dispatch`], which null-checks, catches unwinds and
 //! maps errors to OFX statuses: no panic crosses the C ABI.
 
+/// An OFX main entry point (`OfxPluginEntryPoint`) for a `$kind` node that
+/// hands the host's arguments to `$dispatch`, whose contract is the entry
+/// point's: the action's arguments as the host passed them.
+macro_rules! entry_point {
+    ($name:ident, $kind:expr, $dispatch:path) => {
+        unsafe extern "C" fn $name(
+            action: *const std::ffi::c_char,
+            handle: *const std::ffi::c_void,
+            in_args: openfx::sys::generic::core::OfxPropertySetHandle,
+            out_args: openfx::sys::generic::core::OfxPropertySetHandle,
+        ) -> openfx::sys::generic::core::OfxStatus {
+            // SAFETY: the host calls an entry point with an action's
+            // arguments, which is `$dispatch`'s contract.
+            unsafe { $dispatch($kind, action, handle, in_args, out_args) }
+        }
+    };
+}
+
 pub mod clips;
 pub mod cpu;
 pub mod dispatch;

@@ -69,10 +69,7 @@ impl ParamSet {
     }
 
     fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
-        let get = self
-            .suite
-            .paramGetHandle
-            .ok_or_else(|| Failure::Failed("host has no paramGetHandle".into()))?;
+        let get = need(self.suite.paramGetHandle, "paramGetHandle")?;
         let name = cstr(id);
         let mut h: OfxParamHandle = std::ptr::null_mut();
         // SAFETY: set is the instance's param set; name NUL-terminated; out-pointer live.
@@ -93,9 +90,7 @@ impl ParamSet {
 }
 
 fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &ParamSpec) -> Outcome {
-    let define = suite
-        .paramDefine
-        .ok_or_else(|| Failure::Failed("host has no paramDefine".into()))?;
+    let define = need(suite.paramDefine, "paramDefine")?;
     let kind: &CStr = match &spec.kind {
         Kind::Double { .. } => kOfxParamTypeDouble,
         Kind::Int { .. } => kOfxParamTypeInteger,
@@ -219,6 +214,11 @@ fn set_kind(p: &PropSet, kind: &Kind) -> Outcome {
     Ok(())
 }
 
+/// A suite function the host may leave out, or the error that says so.
+fn need<F>(f: Option<F>, name: &str) -> Outcome<F> {
+    f.ok_or_else(|| Failure::Failed(format!("host has no {name}")))
+}
+
 /// One instance's params, their handles fetched once.
 pub struct Params {
     set: ParamSet,
@@ -250,11 +250,7 @@ impl Params {
         OfxParamHandle,
         unsafe extern "C" fn(OfxParamHandle, OfxTime, ...) -> OfxStatus,
     )> {
-        let f = self
-            .set
-            .suite
-            .paramGetValueAtTime
-            .ok_or_else(|| Failure::Failed("host has no paramGetValueAtTime".into()))?;
+        let f = need(self.set.suite.paramGetValueAtTime, "paramGetValueAtTime")?;
         Ok((self.handle(id)?, f))
     }
 
@@ -288,11 +284,7 @@ impl Params {
 
     /// Keys a Double2D param at `time` (the host adds or moves the key).
     pub fn set_point_at(&self, id: &str, time: f64, (x, y): (f64, f64)) -> Outcome {
-        let f = self
-            .set
-            .suite
-            .paramSetValueAtTime
-            .ok_or_else(|| Failure::Failed("host has no paramSetValueAtTime".into()))?;
+        let f = need(self.set.suite.paramSetValueAtTime, "paramSetValueAtTime")?;
         let h = self.handle(id)?;
         // SAFETY: a Double2D param takes two `double` varargs after the time.
         check(unsafe { f(h, time, x, y) }, &format!("setting {id}"))
@@ -300,11 +292,7 @@ impl Params {
 
     /// Sets a Double2D param's value (a param without keys).
     pub fn set_point(&self, id: &str, (x, y): (f64, f64)) -> Outcome {
-        let f = self
-            .set
-            .suite
-            .paramSetValue
-            .ok_or_else(|| Failure::Failed("host has no paramSetValue".into()))?;
+        let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
         let h = self.handle(id)?;
         // SAFETY: a Double2D param takes two `double` varargs.
         check(unsafe { f(h, x, y) }, &format!("setting {id}"))
@@ -312,11 +300,7 @@ impl Params {
 
     /// Sets an Integer, Boolean or Choice param's value.
     pub fn set_int(&self, id: &str, v: i32) -> Outcome {
-        let f = self
-            .set
-            .suite
-            .paramSetValue
-            .ok_or_else(|| Failure::Failed("host has no paramSetValue".into()))?;
+        let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
         let h = self.handle(id)?;
         // SAFETY: Integer, Boolean and Choice params take one `int` vararg.
         check(unsafe { f(h, v as c_int) }, &format!("setting {id}"))
@@ -334,11 +318,7 @@ impl Params {
 
     /// How many keys the param has.
     pub fn num_keys(&self, id: &str) -> Outcome<u32> {
-        let f = self
-            .set
-            .suite
-            .paramGetNumKeys
-            .ok_or_else(|| Failure::Failed("host has no paramGetNumKeys".into()))?;
+        let f = need(self.set.suite.paramGetNumKeys, "paramGetNumKeys")?;
         let h = self.handle(id)?;
         let mut n: std::ffi::c_uint = 0;
         // SAFETY: the param's handle and a live out-pointer.
@@ -348,11 +328,7 @@ impl Params {
 
     /// Removes every key of the param (its value stays what it was).
     pub fn delete_all_keys(&self, id: &str) -> Outcome {
-        let f = self
-            .set
-            .suite
-            .paramDeleteAllKeys
-            .ok_or_else(|| Failure::Failed("host has no paramDeleteAllKeys".into()))?;
+        let f = need(self.set.suite.paramDeleteAllKeys, "paramDeleteAllKeys")?;
         let h = self.handle(id)?;
         // SAFETY: the param's handle.
         check(unsafe { f(h) }, &format!("deleting keys of {id}"))
@@ -360,11 +336,7 @@ impl Params {
 
     /// Hides or shows the param in the host's UI (`kOfxParamPropSecret`).
     pub fn set_secret(&self, id: &str, secret: bool) -> Outcome {
-        let f = self
-            .set
-            .suite
-            .paramGetPropertySet
-            .ok_or_else(|| Failure::Failed("host has no paramGetPropertySet".into()))?;
+        let f = need(self.set.suite.paramGetPropertySet, "paramGetPropertySet")?;
         let h = self.handle(id)?;
         let mut props: OfxPropertySetHandle = std::ptr::null_mut();
         // SAFETY: the param's handle and a live out-pointer.
