@@ -2,7 +2,8 @@
 // the OpenFX reference host library, then, for each node and each context
 // it must support, creates an instance, checks what the spec mandates in
 // that context, asks for identity where the answer is known, and renders
-// every warp method at render scale 1 and 0.5 in float and 8-bit. Exit
+// every warp method at render scale 1 and 0.5 in float and 8-bit, and
+// drives each node's overlay (draw, and a drag that moves a line). Exit
 // status 0 when every check passed, 1 with the failures listed otherwise.
 #include <cmath>
 #include <iostream>
@@ -104,6 +105,9 @@ void loadScene(IE::Instance &fx, const Where &w) {
 void keyLines(IE::Instance &fx, const Where &w) {
   const double lines[2][8] = {{20, 20, 70, 22, 26, 28, 76, 24},
                               {30, 50, 30, 10, 36, 48, 40, 12}};
+  auto *count = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("line_count"));
+  if (!count) return fail(w.text + ": no integer param line_count");
+  count->set(2);
   for (int k = 0; k < 2; ++k) {
     const std::string slot = "line" + std::to_string(k + 1);
     auto *on = dynamic_cast<OFX::Host::Param::BooleanInstance *>(
@@ -228,6 +232,66 @@ int choiceCount(IE::Instance &fx, const std::string &name) {
   return p ? p->getProperties().getDimension(kOfxParamPropChoiceOption) : 0;
 }
 
+/// The overlay as the library's own interact classes drive it.
+class Overlay : public IE::OverlayInteract {
+ public:
+  explicit Overlay(IE::Instance &fx) : IE::OverlayInteract(fx) {}
+  int redraws = 0;
+  void getViewportSize(double &w, double &h) const override {
+    w = kProjectWidth, h = kProjectHeight;
+  }
+  void getPixelScale(double &x, double &y) const override { x = 1, y = 1; }
+  void getBackgroundColour(double &r, double &g, double &b) const override {
+    r = g = b = 0;
+  }
+  bool getSuggestedColour(double &, double &, double &) const override { return false; }
+  OfxStatus swapBuffers() override {
+    fail("an overlay swapped buffers (the host does)");
+    return kOfxStatFailed;
+  }
+  OfxStatus redraw() override { return ++redraws, kOfxStatOK; }
+};
+
+/// The overlay in a host with no OpenGL context and no Draw suite: draw
+/// succeeds (drawing nothing), and a drag moves the grabbed end of line 1
+/// on A (at (70, 22), keyed by keyLines) to where the pen lets go.
+void checkOverlay(Effect &fx, const Where &w) {
+  if (!fx.getOverlayInteractMainEntry())
+    return fail(w.text + ": no overlay interact entry");
+  Overlay ov(fx);
+  expectOk(ov.createInstanceAction(), w, "overlay createInstance");
+  const OfxPointD scale = {1, 1};
+  expectOk(ov.drawAction(0, scale), w, "overlay draw");
+  const OfxPointD from = {70, 22}, to = {60, 30};
+  const OfxPointI vp = {0, 0};
+  expectOk(ov.penDownAction(0, scale, from, vp, 1), w, "overlay pen down");
+  expectOk(ov.penMotionAction(0, scale, to, vp, 1), w, "overlay pen motion");
+  expectOk(ov.penUpAction(0, scale, to, vp, 0), w, "overlay pen up");
+  auto *end = dynamic_cast<OFX::Host::Param::Double2DInstance *>(fx.getParam("line1_a_end"));
+  double x = 0, y = 0;
+  if (!end || end->get(x, y) != kOfxStatOK || x != to.x || y != to.y) {
+    std::ostringstream m;
+    m << w.text << ": overlay drag left line1_a_end at (" << x << ", " << y
+      << "), not (60, 30)";
+    fail(m.str());
+  }
+  // Clear Line on slot 2: turned off, and Line Count back to 1.
+  expectOk(fx.beginInstanceChangedAction(kOfxChangeUserEdited), w, "beginInstanceChanged");
+  expectOk(fx.paramInstanceChangedAction("line2_clear", kOfxChangeUserEdited, 0, scale), w,
+           "instanceChanged line2_clear");
+  expectOk(fx.endInstanceChangedAction(kOfxChangeUserEdited), w, "endInstanceChanged");
+  auto *on = dynamic_cast<OFX::Host::Param::BooleanInstance *>(fx.getParam("line2_enable"));
+  auto *count = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("line_count"));
+  bool enabled = true;
+  int lines = 0;
+  if (!on || !count || on->get(enabled) != kOfxStatOK || count->get(lines) != kOfxStatOK ||
+      enabled || lines != 1)
+    fail(w.text + ": Clear Line left line 2 enabled or Line Count not 1");
+  // Back as keyLines left them, for the renders that follow.
+  if (end) end->set(from.x, from.y);
+  keyLines(fx, w);
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -248,6 +312,7 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
   expectOk(fx->createInstanceAction(), w, "createInstance");
   if (!fx->getClipPreferences()) fail(w.text + ": getClipPreferences failed");
   checkIdentity(*fx, context, w);
+  if (depth == std::string(kOfxBitDepthFloat)) checkOverlay(*fx, w.with("overlay"));
 
   auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("method"));
   const int methods = choiceCount(*fx, "method");

@@ -44,7 +44,7 @@ Host::Host() {
   _properties.setIntProperty(kOfxPropVersion, 1, 0);
   _properties.setStringProperty(kOfxPropVersionLabel, "1.0");
   _properties.setIntProperty(kOfxImageEffectHostPropIsBackground, 0);
-  _properties.setIntProperty(kOfxImageEffectPropSupportsOverlays, 0);
+  _properties.setIntProperty(kOfxImageEffectPropSupportsOverlays, 1);
   _properties.setIntProperty(kOfxImageEffectPropSupportsMultiResolution, 1);
   _properties.setIntProperty(kOfxImageEffectPropSupportsTiles, 1);
   _properties.setIntProperty(kOfxImageEffectPropTemporalClipAccess, 1);

@@ -4,7 +4,7 @@
 use morphfx::features::Side;
 use morphfx::geom::Vec2;
 
-use super::params::{slot_clear, slot_group, slot_ids, table, Reader, LINE_COUNT, LINE_SLOTS};
+use super::params::{slot_clear, slot_group, slot_ids, spec, Reader, LINE_COUNT, LINE_SLOTS};
 use super::spec::Kind;
 use super::NodeKind;
 use crate::wrapper::params::Params;
@@ -74,7 +74,9 @@ pub fn clear(kind: NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
         for side in [Side::A, Side::B] {
             for end in 0..2 {
                 let id = end_id(k, side, end);
-                params.delete_all_keys(&id)?;
+                // A host without keyframes (or without this call) has no
+                // keys to delete: the value below is all there is.
+                let _ = params.delete_all_keys(&id);
                 params.set_point(&id, default_point(kind, &id))?;
             }
         }
@@ -91,7 +93,7 @@ pub fn clear(kind: NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
 }
 
 fn default_point(kind: NodeKind, id: &str) -> (f64, f64) {
-    match table(kind).iter().find(|p| p.id == id).map(|p| &p.kind) {
+    match spec(kind, id).map(|p| &p.kind) {
         Some(Kind::Point { default }) => *default,
         _ => (0.0, 0.0),
     }

@@ -1,6 +1,7 @@
 //! The params both nodes share, as one table, and their values read at a time.
 
 use std::cell::RefCell;
+use std::collections::HashMap;
 use std::sync::OnceLock;
 
 use morphfx::choice::Choice;
@@ -431,6 +432,20 @@ fn slot_specs(k: usize) -> Vec<ParamSpec> {
     specs
 }
 
+/// The table entry of param `id`, through an index built once per node: a
+/// render reads a few hundred params from a table of several hundred.
+pub fn spec(kind: NodeKind, id: &str) -> Option<&'static ParamSpec> {
+    type Index = HashMap<&'static str, &'static ParamSpec>;
+    static MORPH: OnceLock<Index> = OnceLock::new();
+    static WARP: OnceLock<Index> = OnceLock::new();
+    let build = || table(kind).iter().map(|p| (p.id.as_str(), p)).collect();
+    let index = match kind {
+        NodeKind::Morph => MORPH.get_or_init(build),
+        NodeKind::Warp => WARP.get_or_init(build),
+    };
+    index.get(id).copied()
+}
+
 /// The params a node defines in `context`: its table, and in the
 /// transition context the mandated `Transition` param (Parameters Mandated
 /// In A Context: the plugin defines it, the host drives it).
@@ -476,7 +491,7 @@ pub struct Settings {
 pub struct Reader<'a> {
     /// `None`: every param at its default.
     params: Option<&'a Params>,
-    table: &'a [ParamSpec],
+    kind: NodeKind,
     time: f64,
     missing: RefCell<Vec<String>>,
 }
@@ -485,16 +500,14 @@ impl<'a> Reader<'a> {
     pub fn new(params: &'a Params, kind: NodeKind, time: f64) -> Self {
         Reader {
             params: Some(params),
-            table: table(kind),
+            kind,
             time,
             missing: RefCell::new(Vec::new()),
         }
     }
 
-    fn spec(&self, id: &str) -> &'a ParamSpec {
-        self.table
-            .iter()
-            .find(|p| p.id == id)
+    fn spec(&self, id: &str) -> &'static ParamSpec {
+        spec(self.kind, id)
             .unwrap_or_else(|| panic!("param {id} is read but not in the node's table"))
     }
 
@@ -582,7 +595,7 @@ impl Settings {
     pub fn defaults(kind: NodeKind) -> Settings {
         let reader = Reader {
             params: None,
-            table: table(kind),
+            kind,
             time: 0.0,
             missing: RefCell::new(Vec::new()),
         };

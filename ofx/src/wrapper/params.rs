@@ -307,9 +307,11 @@ impl Params {
     }
 
     /// Moves a point the user is editing: keyed at `time` when the param
-    /// already animates (other keys stay), set outright when it has none.
+    /// already animates (other keys stay), set outright when it has none,
+    /// or when the host cannot count keys (the OpenFX reference host
+    /// library answers `kOfxStatErrMissingHostFeature`).
     pub fn move_point(&self, id: &str, time: f64, p: (f64, f64)) -> Outcome {
-        if self.num_keys(id)? > 0 {
+        if self.num_keys(id).is_ok_and(|n| n > 0) {
             self.set_point_at(id, time, p)
         } else {
             self.set_point(id, p)

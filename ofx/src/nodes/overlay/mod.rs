@@ -313,14 +313,16 @@ fn screen_length(p: Vec2, q: Vec2, pixel: (f64, f64)) -> f64 {
     Vec2::new((q.x - p.x) / pixel.0, (q.y - p.y) / pixel.1).length()
 }
 
-/// Keys the overlay knows (X11 keysyms, as OFX sends them).
-pub mod keys {
+/// Keys the overlay knows (OFX key symbols).
+mod keys {
+    use openfx::sys::image_effect_v1::key_syms::*;
+
     /// Left and right Shift.
-    pub const SHIFT: [i32; 2] = [0xffe1, 0xffe2];
+    pub const SHIFT: [i32; 2] = [kOfxKey_Shift_L as i32, kOfxKey_Shift_R as i32];
     /// Left and right Control.
-    pub const CONTROL: [i32; 2] = [0xffe3, 0xffe4];
+    pub const CONTROL: [i32; 2] = [kOfxKey_Control_L as i32, kOfxKey_Control_R as i32];
     /// Delete and BackSpace.
-    pub const DELETE: [i32; 2] = [0xffff, 0xff08];
+    pub const DELETE: [i32; 2] = [kOfxKey_Delete as i32, kOfxKey_BackSpace as i32];
 }
 
 /// Key down: modifiers narrow what the pen grabs (and stay the host's
