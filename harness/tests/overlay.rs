@@ -236,8 +236,24 @@ fn a_drag_in_empty_space_draws_a_new_line_into_the_next_slot() {
     assert_eq!(slot3("a_end"), [500.0, 450.0]);
     assert_eq!(slot3("b_start"), [400.0, 400.0]);
     assert_eq!(slot3("b_end"), [500.0, 450.0]);
-    let segs = segments(&ov.draw(0.0, (1.0, 1.0)).unwrap());
-    assert!(segs.contains(&[[400.0, 400.0], [500.0, 450.0]]));
+    let calls = ov.draw(0.0, (1.0, 1.0)).unwrap();
+    assert!(segments(&calls).contains(&[[400.0, 400.0], [500.0, 450.0]]));
+    // A's and B's starts coincide; their two labels "3" do not: A's above
+    // the start, B's below, each at least a label's height (10 px) apart.
+    let threes: Vec<[f64; 2]> = calls
+        .iter()
+        .filter_map(|c| match c {
+            DrawCall::Text { text, at, .. } if text == "3" => Some(*at),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(threes.len(), 4, "A and B, each with its shadow");
+    let (above, below): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
+        threes.iter().partition(|at| at[1] > 400.0);
+    assert_eq!((above.len(), below.len()), (2, 2), "{threes:?}");
+    assert!(above
+        .iter()
+        .all(|a| below.iter().all(|b| a[1] - b[1] >= 10.0)));
     // A click (no drag) makes no line.
     ov.drag(0.0, (600.0, 600.0), (600.5, 600.0), (1.0, 1.0))
         .unwrap();

@@ -3,13 +3,15 @@
 // it must support, creates an instance, checks what the spec mandates in
 // that context, asks for identity where the answer is known, and renders
 // every warp method at render scale 1 and 0.5 in float and 8-bit, and
-// drives each node's overlay (draw, and a drag that moves a line). Exit
+// drives each node's overlay (draw, and a drag that moves a line; drawn in
+// an offscreen OpenGL context too, where Mesa's EGL is there). Exit
 // status 0 when every check passed, 1 with the failures listed otherwise.
 #include <cmath>
 #include <iostream>
 #include <set>
 #include <sstream>
 
+#include "glcontext.h"
 #include "refhost.h"
 
 using namespace refhost;
@@ -292,6 +294,78 @@ void checkOverlay(Effect &fx, const Where &w) {
   keyLines(fx, w);
 }
 
+/// Whether some pixel within 2 of (x, y) has the hue of `colour` (the
+/// overlay's lines are anti-aliased over the background, so not its value).
+bool hueNear(const GlContext &gl, int x, int y, bool orange) {
+  for (int dy = -2; dy <= 2; ++dy)
+    for (int dx = -2; dx <= 2; ++dx) {
+      const Rgba p = gl.pixel(x + dx, y + dy);
+      const bool is = orange ? p.r > p.g && p.g > p.b && p.r - p.b > 0.4f
+                             : p.b > p.g && p.g > p.r && p.b - p.r > 0.4f;
+      if (is) return true;
+    }
+  return false;
+}
+
+/// The overlay in a viewer with an OpenGL context current, no Draw suite,
+/// zoomed to 2 screen pixels per canonical unit while the host reports a
+/// pixel scale of (1, 1), as some hosts do at every zoom. Line 1's A (orange)
+/// and B (blue) are drawn where they are, nothing is drawn away from the
+/// lines, the GL state is left as found, and the pen's hit radius follows
+/// the zoom the projection shows: 6.5 units from an end is 13 screen pixels,
+/// outside the 8-pixel radius, so a click there grabs nothing.
+void checkOverlayGl(Effect &fx, const Where &w) {
+  const int zoom = 2;
+  GlContext gl(kProjectWidth * zoom, kProjectHeight * zoom);
+  if (!gl.ready()) {
+    static bool said = false;
+    if (!said) std::cout << "refhost: GL overlay check SKIPPED: " << gl.why() << std::endl;
+    said = true;
+    return;
+  }
+  gl.viewerFrame(kProjectWidth, kProjectHeight, {0.2f, 0.2f, 0.2f, 1});
+  Overlay ov(fx);
+  expectOk(ov.createInstanceAction(), w, "overlay createInstance");
+  const OfxPointD scale = {1, 1};
+  expectOk(ov.drawAction(0, scale), w, "overlay draw");
+  // Line 1 (keyLines): A (20, 20) - (70, 22), B (26, 28) - (76, 24).
+  if (!hueNear(gl, 45 * zoom, 21 * zoom, true))
+    fail(w.text + ": line 1's A is not drawn orange at its middle (45, 21)");
+  if (!hueNear(gl, 51 * zoom, 26 * zoom, false))
+    fail(w.text + ": line 1's B is not drawn blue at its middle (51, 26)");
+  const Rgba empty = gl.pixel(90 * zoom, 5 * zoom);
+  if (std::fabs(empty.r - 0.2f) > 0.004f || std::fabs(empty.g - 0.2f) > 0.004f ||
+      std::fabs(empty.b - 0.2f) > 0.004f) {
+    std::ostringstream m;
+    m << w.text << ": the overlay drew at (90, 5), far from every line: (" << empty.r << ", "
+      << empty.g << ", " << empty.b << ")";
+    fail(m.str());
+  }
+  const Rgba c = gl.currentColour();
+  if (gl.blendEnabled() || gl.stippleEnabled() || gl.lineWidth() != 1.0f ||
+      c.r != 0.1f || c.g != 0.2f || c.b != 0.3f || c.a != 0.4f)
+    fail(w.text + ": the overlay's draw left GL state changed (blend, stipple, width, colour)");
+
+  const OfxPointD near = {20, 13.5}, nudge = {20.5, 13.8};
+  const OfxPointI vp = {0, 0};
+  expectOk(ov.penDownAction(0, scale, near, vp, 1), w, "overlay pen down");
+  expectOk(ov.penMotionAction(0, scale, nudge, vp, 1), w, "overlay pen motion");
+  expectOk(ov.penUpAction(0, scale, nudge, vp, 0), w, "overlay pen up");
+  auto *start =
+      dynamic_cast<OFX::Host::Param::Double2DInstance *>(fx.getParam("line1_a_start"));
+  auto *count = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("line_count"));
+  double x = 0, y = 0;
+  int lines = 0;
+  if (!start || start->get(x, y) != kOfxStatOK || x != 20 || y != 20 || !count ||
+      count->get(lines) != kOfxStatOK || lines != 2) {
+    std::ostringstream m;
+    m << w.text << ": a click 13 screen pixels from line 1's A start moved it to (" << x
+      << ", " << y << ") or left Line Count " << lines
+      << ": the hit radius did not follow the projection's zoom";
+    fail(m.str());
+  }
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -312,7 +386,10 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
   expectOk(fx->createInstanceAction(), w, "createInstance");
   if (!fx->getClipPreferences()) fail(w.text + ": getClipPreferences failed");
   checkIdentity(*fx, context, w);
-  if (depth == std::string(kOfxBitDepthFloat)) checkOverlay(*fx, w.with("overlay"));
+  if (depth == std::string(kOfxBitDepthFloat)) {
+    checkOverlay(*fx, w.with("overlay"));
+    checkOverlayGl(*fx, w.with("overlay in OpenGL"));
+  }
 
   auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("method"));
   const int methods = choiceCount(*fx, "method");

@@ -3,7 +3,8 @@
 //! GL is opened at run time, never linked: the library the host already
 //! has loaded first, else the system's. The bundle then loads where there is
 //! no libGL at all, and simply draws nothing there, or when no GL context is
-//! current.
+//! current. On Linux a viewer's context may be GLX's (X11) or EGL's (Qt on
+//! Wayland, or offscreen); libGL's entry points draw into either.
 
 use std::ffi::{c_double, c_float, c_int, c_uint, c_void};
 use std::sync::OnceLock;
@@ -11,7 +12,7 @@ use std::sync::OnceLock;
 use morphfx::geom::Vec2;
 use morphfx::strokes;
 
-use crate::nodes::overlay::paint::{Painter, Stipple};
+use crate::nodes::overlay::paint::{Painter, Stipple, LABEL_PX};
 
 type GLenum = c_uint;
 
@@ -31,9 +32,6 @@ const GL_LINE_BIT: GLenum = 0x0004;
 const GL_ENABLE_BIT: GLenum = 0x2000;
 const GL_COLOR_BUFFER_BIT: GLenum = 0x4000;
 const GL_HINT_BIT: GLenum = 0x8000;
-
-/// Label cap height in screen pixels.
-const LABEL_PX: f64 = 10.0;
 
 /// The GL 1.1 entry points the overlay uses, resolved once.
 struct Gl {
@@ -56,6 +54,8 @@ struct Gl {
     _lib: libloading::Library,
 }
 
+type EglCurrent = unsafe extern "system" fn() -> *mut c_void;
+
 #[cfg(target_os = "linux")]
 const LIBRARY: &str = "libGL.so.1";
 #[cfg(target_os = "macos")]
@@ -70,20 +70,41 @@ const CURRENT_CONTEXT: &[u8] = b"CGLGetCurrentContext\0";
 #[cfg(windows)]
 const CURRENT_CONTEXT: &[u8] = b"wglGetCurrentContext\0";
 
+/// `name` when the process has it loaded already.
+#[cfg(unix)]
+fn loaded(name: &str) -> Option<libloading::Library> {
+    use libloading::os::unix::{Library, RTLD_NOW};
+    // SAFETY: RTLD_NOLOAD only finds a library already in the process; it
+    // runs no initialisers.
+    let lib = unsafe { Library::open(Some(name), RTLD_NOW | libc::RTLD_NOLOAD) };
+    lib.ok().map(Into::into)
+}
+
 /// The library the host has loaded, else the system's; `None` without one.
 fn open() -> Option<libloading::Library> {
     #[cfg(unix)]
-    {
-        use libloading::os::unix::{Library, RTLD_NOW};
-        // SAFETY: RTLD_NOLOAD only finds a library already in the process;
-        // it runs no initialisers.
-        if let Ok(lib) = unsafe { Library::open(Some(LIBRARY), RTLD_NOW | libc::RTLD_NOLOAD) } {
-            return Some(lib.into());
-        }
+    if let Some(lib) = loaded(LIBRARY) {
+        return Some(lib);
     }
     // SAFETY: loading the system's GL runs its initialisers, which every
     // GL application runs; the host process is such an application.
     unsafe { libloading::Library::new(LIBRARY) }.ok()
+}
+
+/// EGL's `eglGetCurrentContext`, only from a libEGL the host has loaded:
+/// a host that never loaded it has no EGL context to draw into.
+#[cfg(target_os = "linux")]
+fn open_egl() -> Option<(libloading::Library, EglCurrent)> {
+    let lib = loaded("libEGL.so.1")?;
+    // SAFETY: EGL 1.0's `EGLContext eglGetCurrentContext(void)`.
+    let current: EglCurrent = *unsafe { lib.get(b"eglGetCurrentContext\0") }.ok()?;
+    Some((lib, current))
+}
+
+/// Elsewhere the window system's own call finds every context.
+#[cfg(not(target_os = "linux"))]
+fn open_egl() -> Option<(libloading::Library, EglCurrent)> {
+    None
 }
 
 fn load() -> Option<Gl> {
@@ -121,6 +142,28 @@ fn gl() -> Option<&'static Gl> {
     GL.get_or_init(load).as_ref()
 }
 
+/// EGL, once the host has loaded it (looked for again until then: a host
+/// may load it only when it opens its first viewer).
+fn egl() -> Option<EglCurrent> {
+    static EGL: OnceLock<(libloading::Library, EglCurrent)> = OnceLock::new();
+    if let Some((_, current)) = EGL.get() {
+        return Some(*current);
+    }
+    let found = open_egl()?;
+    Some(EGL.get_or_init(|| found).1)
+}
+
+impl Gl {
+    /// Whether the calling thread has a GL context current.
+    fn has_context(&self) -> bool {
+        // SAFETY: both ask their window system for the calling thread's
+        // context; safe with or without one.
+        unsafe {
+            !(self.current_context)().is_null() || egl().is_some_and(|current| !current().is_null())
+        }
+    }
+}
+
 /// Draws with OpenGL 1.1 into the host's current context; restores the GL
 /// state it changes when dropped.
 pub struct GlPainter {
@@ -133,9 +176,7 @@ impl GlPainter {
     /// with GL has one); `None` otherwise.
     pub fn new(host_pixel: (f64, f64)) -> Option<GlPainter> {
         let gl = gl()?;
-        // SAFETY: asks the window system for the calling thread's context;
-        // safe with or without one.
-        if unsafe { (gl.current_context)() }.is_null() {
+        if !gl.has_context() {
             return None;
         }
         // SAFETY: a context is current on this thread (checked above), and

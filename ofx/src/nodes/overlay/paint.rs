@@ -61,6 +61,9 @@ const SHADOW: [f32; 4] = [0.0, 0.0, 0.0, 0.8];
 const ARROW_PX: f64 = 10.0;
 const LABEL_GAP_PX: f64 = 6.0;
 const HANDLE_PX: f64 = 4.0;
+/// A label's cap height in screen pixels, for painters that draw text
+/// themselves (OpenGL has none).
+pub const LABEL_PX: f64 = 10.0;
 
 /// Draws `frame`: everything twice, a dark shadow one pixel down and right,
 /// then in colour, so it reads on any plate.
@@ -138,8 +141,15 @@ impl Pen<'_> {
         self.painter.lines(&pts);
     }
 
-    fn label(&mut self, at: Vec2, text: &str) {
-        let at = self.at(at + self.screen(-LABEL_GAP_PX * 2.0, LABEL_GAP_PX));
+    /// `text` beside `at`: above-left of it for A, below-left for B, so the
+    /// two numbers stay apart when A's and B's starts coincide (a line just
+    /// drawn has both on the same spot).
+    fn label(&mut self, at: Vec2, side: Side, text: &str) {
+        let dy = match side {
+            Side::A => LABEL_GAP_PX,
+            Side::B => -LABEL_GAP_PX - LABEL_PX,
+        };
+        let at = self.at(at + self.screen(-LABEL_GAP_PX * 2.0, dy));
         self.painter.text(at, text);
     }
 
@@ -197,7 +207,7 @@ impl Pen<'_> {
                 self.colour(colour, 1.0);
                 let line = l.side(side);
                 self.arrow(line);
-                self.label(line[0], &l.slot.to_string());
+                self.label(line[0], side, &l.slot.to_string());
                 if let Some(h) = hovered {
                     self.handle(line, h.part);
                 }
