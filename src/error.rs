@@ -23,6 +23,9 @@ pub enum Error {
     /// Something this build does not do (yet).
     #[error("not supported: {0}")]
     Unsupported(String),
+    /// Stopped on request (a host's cancel, Ctrl-C) before the end.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 impl Error {

@@ -24,6 +24,7 @@ pub mod scene;
 pub mod snake;
 pub mod strokes;
 pub mod testing;
+pub mod track;
 pub mod transition;
 pub mod views;
 pub mod warp;

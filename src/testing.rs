@@ -111,3 +111,154 @@ pub fn smooth_pairs(
     }
     points.into_iter().map(|p| (p, p + field(p))).collect()
 }
+
+/// A known smooth non-rigid motion over a shot, for trackers: frame `f` of
+/// `frames` rotates by up to `rotate_deg` and zooms by up to `zoom` about
+/// `centre`, drifts by up to `drift`, and bends the picture near `bend_at`
+/// by up to `bend` px (a Gaussian bump of radius `bend_radius`); each grows
+/// linearly from nothing at frame 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShotMotion {
+    /// The last frame (the first is 0).
+    pub frames: usize,
+    /// The centre of rotation and zoom.
+    pub centre: Vec2,
+    /// Rotation at the last frame, degrees.
+    pub rotate_deg: f64,
+    /// Scale at the last frame.
+    pub zoom: f64,
+    /// Translation at the last frame.
+    pub drift: Vec2,
+    /// Peak displacement of the local bend at the last frame.
+    pub bend: Vec2,
+    /// Where the bend peaks.
+    pub bend_at: Vec2,
+    /// The bend's Gaussian radius.
+    pub bend_radius: f64,
+}
+
+impl ShotMotion {
+    /// Where the point at `p` in frame 0 lies in frame `frame`.
+    pub fn at(&self, frame: usize, p: Vec2) -> Vec2 {
+        let s = frame as f64 / self.frames.max(1) as f64;
+        let (sin, cos) = (self.rotate_deg * s).to_radians().sin_cos();
+        let zoom = 1.0 + (self.zoom - 1.0) * s;
+        let d = p - self.centre;
+        let turned = Vec2::new(cos * d.x - sin * d.y, sin * d.x + cos * d.y) * zoom;
+        let r2 = (p - self.bend_at).length_squared() / (2.0 * self.bend_radius.powi(2));
+        self.centre + turned + self.drift * s + self.bend * (s * (-r2).exp())
+    }
+
+    /// The point of frame 0 that lands at `x` in frame `frame` (Newton's
+    /// method on [`ShotMotion::at`], which is smooth and one-to-one).
+    pub fn source_of(&self, frame: usize, x: Vec2) -> Vec2 {
+        let mut p = x;
+        for _ in 0..20 {
+            let r = self.at(frame, p) - x;
+            if r.length() < 1e-9 {
+                break;
+            }
+            let h = 1e-4;
+            let jx = (self.at(frame, p + Vec2::new(h, 0.0)) - self.at(frame, p)) * (1.0 / h);
+            let jy = (self.at(frame, p + Vec2::new(0.0, h)) - self.at(frame, p)) * (1.0 / h);
+            let det = jx.x * jy.y - jy.x * jx.y;
+            p = p - Vec2::new(jy.y * r.x - jy.x * r.y, -jx.y * r.x + jx.x * r.y) * (1.0 / det);
+        }
+        p
+    }
+}
+
+/// Frame `frame` of a shot of `photo` moved by `motion` (bilinear, edge
+/// pixels held outside), with a flicker of gain `1 ± flicker` and a grain of
+/// relative standard deviation `grain`, both random per frame from `seed`.
+/// RGBA, alpha 1.
+pub fn shot_frame(
+    photo: &Image,
+    motion: &ShotMotion,
+    frame: usize,
+    flicker: f64,
+    grain: f64,
+    seed: u64,
+) -> Image {
+    let mut r = Lcg::new(seed ^ (frame as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let gain = if frame == 0 {
+        1.0
+    } else {
+        1.0 + r.range(-flicker, flicker)
+    };
+    let b = photo.bounds;
+    let mut out = Image::new(b, 4);
+    let c = photo.channels;
+    let at = |i: i32, j: i32, k: usize| {
+        let (i, j) = (i.clamp(b.x1, b.x2 - 1), j.clamp(b.y1, b.y2 - 1));
+        photo.pixel(i, j)[k.min(c - 1)]
+    };
+    let mut k = 0;
+    for j in b.y1..b.y2 {
+        for i in b.x1..b.x2 {
+            let p = motion.source_of(frame, Vec2::new(i as f64 + 0.5, j as f64 + 0.5));
+            let (u, v) = (p.x - 0.5, p.y - 0.5);
+            let (i0, j0) = (u.floor() as i32, v.floor() as i32);
+            let (fx, fy) = ((u - u.floor()) as f32, (v - v.floor()) as f32);
+            // One grain value for the pixel (luminance grain), Box-Muller.
+            let g =
+                (-2.0 * r.unit().max(1e-12).ln()).sqrt() * (std::f64::consts::TAU * r.unit()).cos();
+            for ch in 0..3 {
+                let top = at(i0, j0, ch) * (1.0 - fx) + at(i0 + 1, j0, ch) * fx;
+                let bottom = at(i0, j0 + 1, ch) * (1.0 - fx) + at(i0 + 1, j0 + 1, ch) * fx;
+                let value = (top * (1.0 - fy) + bottom * fy) as f64;
+                out.data[k + ch] = (value * gain * (1.0 + grain * g)) as f32;
+            }
+            out.data[k + 3] = 1.0;
+            k += 4;
+        }
+    }
+    out
+}
+
+/// Up to `n` well-textured corners of `image` (largest smaller eigenvalue
+/// of the 2×2 gradient structure tensor over 9×9 pixels), at pixel centres,
+/// at least `gap` apart and `margin` inside the edges: features a user would
+/// key, picked by a rule independent of any tracker.
+pub fn corners(image: &Image, n: usize, gap: f64, margin: f64) -> Vec<Vec2> {
+    let b = image.bounds;
+    let c = image.channels;
+    let lum = |i: i32, j: i32| {
+        let p = image.pixel(i.clamp(b.x1, b.x2 - 1), j.clamp(b.y1, b.y2 - 1));
+        if c >= 3 {
+            0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+        } else {
+            p[0]
+        }
+    };
+    let m = margin.ceil() as i32;
+    let mut scored = Vec::new();
+    for j in (b.y1 + m..b.y2 - m).step_by(2) {
+        for i in (b.x1 + m..b.x2 - m).step_by(2) {
+            let (mut xx, mut xy, mut yy) = (0.0f64, 0.0f64, 0.0f64);
+            for dj in -4..=4 {
+                for di in -4..=4 {
+                    let (x, y) = (i + di, j + dj);
+                    let gx = 0.5 * (lum(x + 1, y) - lum(x - 1, y)) as f64;
+                    let gy = 0.5 * (lum(x, y + 1) - lum(x, y - 1)) as f64;
+                    xx += gx * gx;
+                    xy += gx * gy;
+                    yy += gy * gy;
+                }
+            }
+            let min_eig = 0.5 * (xx + yy) - (0.25 * (xx - yy).powi(2) + xy * xy).sqrt();
+            scored.push((min_eig, Vec2::new(i as f64 + 0.5, j as f64 + 0.5)));
+        }
+    }
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut picked: Vec<Vec2> = Vec::new();
+    for (_, p) in scored {
+        if picked.len() == n {
+            break;
+        }
+        if picked.iter().all(|q| q.distance(p) >= gap) {
+            picked.push(p);
+        }
+    }
+    picked
+}

@@ -14,6 +14,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("bspline", 1),
     ("image", 1),
     ("warp", 2),
+    ("track", 2),
     ("transition", 3),
     ("snake", 3),
     ("make_warp", 4),

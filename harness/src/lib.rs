@@ -3,6 +3,8 @@
 
 pub mod host;
 pub mod io;
+pub mod progress;
 pub mod raster;
 pub mod sequence;
 pub mod snap;
+pub mod track;

@@ -1,6 +1,5 @@
 //! `morphfx`: render the MorphFX bundle on plates (docs/command-line.md).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -10,13 +9,16 @@ use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx::scene::Scene;
 use morphfx::snake::SnakeSettings;
+use morphfx::track::TrackSettings;
 use morphfx_harness::host::overlay::Overlay;
 use morphfx_harness::host::{
     Bundle, ErrorKind, Frame, FrameSource, HostError, HostOptions, Instance, OutputSpec,
 };
 use morphfx_harness::io::{self, ExrPrecision, Plate};
+use morphfx_harness::progress::Progress;
 use morphfx_harness::sequence::{frame_path, is_sequence, parse_frames};
 use morphfx_harness::snap::Snap;
+use morphfx_harness::track::Track;
 
 const MORPH_ID: &str = "net.morphfx.Morph";
 const WARP_ID: &str = "net.morphfx.Warp";
@@ -148,6 +150,31 @@ enum Command {
         #[arg(long)]
         clamp_controls: bool,
     },
+    /// Follow the scene's keyed features through sequence A (and B) and
+    /// write the scene with a keyframe at every frame of the range.
+    Track {
+        #[arg(long)]
+        scene: PathBuf,
+        /// Sequence A, #-numbered (plate.####.exr).
+        #[arg(long)]
+        a: String,
+        /// Sequence B: its features are tracked too; without it they keep
+        /// their keyed (or interpolated) positions.
+        #[arg(long)]
+        b: Option<String>,
+        /// The range to track, FIRST-LAST; it must hold a keyframe.
+        #[arg(long)]
+        frames: String,
+        /// The tracked scene; standard output without it.
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+        /// Half the side of the tracked patch, pixels.
+        #[arg(long, default_value_t = TrackSettings::default().radius)]
+        radius: usize,
+        /// Correlation with the keyed patch below which a feature counts as lost.
+        #[arg(long, default_value_t = TrackSettings::default().min_correlation)]
+        min_correlation: f64,
+    },
     /// Time a whole sequence morph on generated plates (EXR IO included) and
     /// say where the time went.
     Bench {
@@ -242,6 +269,23 @@ fn run(cli: Cli) -> Result<(), HostError> {
             },
         }
         .run(),
+        Command::Track {
+            scene,
+            a,
+            b,
+            frames,
+            output,
+            radius,
+            min_correlation,
+        } => track_job(
+            &scene,
+            &a,
+            b.as_deref(),
+            &frames,
+            output.as_deref(),
+            radius,
+            min_correlation,
+        ),
         Command::Bench {
             output,
             frames,
@@ -249,6 +293,41 @@ fn run(cli: Cli) -> Result<(), HostError> {
             height,
         } => bench(&bundle_path()?, &output, frames, (width, height)),
     }
+}
+
+/// `morphfx track`, its options checked.
+fn track_job(
+    scene: &Path,
+    a: &str,
+    b: Option<&str>,
+    frames: &str,
+    output: Option<&Path>,
+    radius: usize,
+    min_correlation: f64,
+) -> Result<(), HostError> {
+    if !(2..=64).contains(&radius) {
+        return Err(HostError::bad(format!(
+            "--radius {radius}: must be 2 to 64 pixels"
+        )));
+    }
+    if !(0.0..1.0).contains(&min_correlation) {
+        return Err(HostError::bad(format!(
+            "--min-correlation {min_correlation}: must be at least 0 and below 1"
+        )));
+    }
+    Track {
+        scene,
+        a,
+        b,
+        frames: parse_frames(frames)?,
+        output,
+        settings: TrackSettings {
+            radius,
+            min_correlation,
+            ..TrackSettings::default()
+        },
+    }
+    .run()
 }
 
 /// `morphfx plugins`: each plugin of the bundle with its version.
@@ -773,63 +852,6 @@ fn check_inputs(plates: &[(String, Arc<Plates>)], frames: &[i64]) -> Result<Inpu
         half,
         windows,
     })
-}
-
-/// Frame n/N, fps and ETA on a terminal; plain lines otherwise.
-struct Progress {
-    bar: Option<indicatif::ProgressBar>,
-    total: usize,
-    start: std::time::Instant,
-}
-
-impl Progress {
-    fn new(total: usize) -> Self {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let b = indicatif::ProgressBar::new(total as u64);
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{bar:30} frame {pos}/{len}  {per_sec}  ETA {eta}  {msg}",
-                )
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            b
-        });
-        Progress {
-            bar,
-            total,
-            start: std::time::Instant::now(),
-        }
-    }
-    fn tick(&self, n: usize, frame: i64) {
-        match &self.bar {
-            Some(b) => {
-                b.set_message(format!("(frame {frame})"));
-                b.set_position(n as u64);
-            }
-            None if self.total > 1 => {
-                let secs = self.start.elapsed().as_secs_f64();
-                let fps = n as f64 / secs.max(1e-9);
-                let eta = (self.total - n) as f64 / fps.max(1e-9);
-                eprintln!(
-                    "frame {n}/{} ({frame})  {fps:.2} fps  ETA {eta:.0}s",
-                    self.total
-                );
-            }
-            None => {}
-        }
-    }
-    /// Finishes the bar and says where the time went.
-    fn done(&self, breakdown: &str) {
-        if let Some(b) = &self.bar {
-            b.finish();
-        }
-        let secs = self.start.elapsed().as_secs_f64();
-        eprintln!(
-            "{} frame(s) in {secs:.2} s ({:.2} fps): {breakdown}",
-            self.total,
-            self.total as f64 / secs.max(1e-9)
-        );
-    }
 }
 
 /// Plate sequences A and B of `frames` frames (a drifting pattern each), a

@@ -161,7 +161,7 @@ fn to_json(points: &[Vec2]) -> Value {
     )
 }
 
-fn write_atomically(path: &Path, text: &str) -> Result<(), HostError> {
+pub fn write_atomically(path: &Path, text: &str) -> Result<(), HostError> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())

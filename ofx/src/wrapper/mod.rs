@@ -69,6 +69,7 @@ impl From<morphfx::Error> for Failure {
             morphfx::Error::Unsupported(_)
             | morphfx::Error::Scene { .. }
             | morphfx::Error::Invalid(_) => Failure::BadInput(e.to_string()),
+            morphfx::Error::Cancelled => Failure::Failed(e.to_string()),
         }
     }
 }
