@@ -8,6 +8,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::thread::JoinHandle;
 
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::Vec2;
@@ -31,32 +32,70 @@ pub struct Track<'a> {
     pub settings: TrackSettings,
 }
 
-/// Pyramids of one sequence, read on demand and kept while they fit a
-/// budget (a range between two keys is swept forward, then backward).
+/// Pyramids of one sequence, read on demand. The next frame of a sweep is
+/// read ahead on another thread while this one is tracked; frames a later
+/// sweep comes back to (those between two keys) are kept until then.
 struct Reader {
     pattern: String,
-    cache: HashMap<i64, Arc<Pyramid>>,
-    bytes: usize,
     levels: usize,
+    /// Frames strictly between two keys: swept forward, then backward.
+    revisited: Vec<(i64, i64)>,
+    cache: HashMap<i64, Arc<Pyramid>>,
+    ahead: Option<(i64, Loading)>,
+    last: Option<i64>,
+    range: (i64, i64),
 }
 
-/// What the pyramids of one sequence may hold in memory.
-const CACHE_BYTES: usize = 768 << 20;
+/// A frame being read on another thread.
+type Loading = JoinHandle<Result<Arc<Pyramid>, HostError>>;
+
+impl Reader {
+    fn new(pattern: &str, levels: usize, keys: &[i64], range: (i64, i64)) -> Reader {
+        Reader {
+            pattern: pattern.to_string(),
+            levels,
+            revisited: keys.windows(2).map(|w| (w[0] + 1, w[1] - 1)).collect(),
+            cache: HashMap::new(),
+            ahead: None,
+            last: None,
+            range,
+        }
+    }
+
+    fn load(pattern: &str, frame: i64, levels: usize) -> Result<Arc<Pyramid>, HostError> {
+        let plate = io::read(&frame_path(pattern, frame))?;
+        let grey = Grey::from_view(&plate.image.view());
+        Ok(Arc::new(Pyramid::new(grey, levels, 16)))
+    }
+
+    fn revisited(&self, frame: i64) -> bool {
+        self.revisited
+            .iter()
+            .any(|&(a, b)| (a..=b).contains(&frame))
+    }
+}
 
 impl Frames<HostError> for Reader {
     fn pyramid(&mut self, frame: i64) -> Result<Arc<Pyramid>, HostError> {
-        if let Some(p) = self.cache.get(&frame) {
-            return Ok(p.clone());
-        }
-        let plate = io::read(&frame_path(&self.pattern, frame))?;
-        let pyramid = Arc::new(Pyramid::new(
-            Grey::from_view(&plate.image.view()),
-            self.levels,
-            16,
-        ));
-        if self.bytes + pyramid.bytes() <= CACHE_BYTES {
-            self.bytes += pyramid.bytes();
+        let ahead = self.ahead.take_if(|(f, _)| *f == frame);
+        let pyramid = match (self.cache.get(&frame), ahead) {
+            (Some(p), _) => p.clone(),
+            (None, Some((_, job))) => job
+                .join()
+                .map_err(|_| HostError::failed("the frame reader stopped"))??,
+            (None, None) => Reader::load(&self.pattern, frame, self.levels)?,
+        };
+        if self.revisited(frame) {
             self.cache.insert(frame, pyramid.clone());
+        }
+        // The sweep goes on in the same direction: read its next frame now.
+        let next = frame + self.last.map_or(1, |l| (frame - l).signum());
+        self.last = Some(frame);
+        let (lo, hi) = self.range;
+        if self.ahead.is_none() && (lo..=hi).contains(&next) && !self.cache.contains_key(&next) {
+            let (pattern, levels) = (self.pattern.clone(), self.levels);
+            let job = std::thread::spawn(move || Reader::load(&pattern, next, levels));
+            self.ahead = Some((next, job));
         }
         Ok(pyramid)
     }
@@ -106,12 +145,8 @@ impl Track<'_> {
                     points: features.iter().map(|f| f.points(*side).to_vec()).collect(),
                 })
                 .collect();
-            let mut reader = Reader {
-                pattern: pattern.to_string(),
-                cache: HashMap::new(),
-                bytes: 0,
-                levels: self.settings.levels,
-            };
+            let key_frames: Vec<i64> = keys.iter().map(|k| k.0).collect();
+            let mut reader = Reader::new(pattern, self.settings.levels, &key_frames, (first, last));
             let estimates = track_side(
                 &kinds,
                 &side_keys,

@@ -6,6 +6,8 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use crate::error::{Error, Result};
 use crate::features::FeatureKind;
 use crate::geom::Vec2;
@@ -56,13 +58,16 @@ pub fn track_side<E: From<Error>>(
         let ahead = keys.get(i + 1).map_or(last, |k| k.frame - 1);
         let behind = if i == 0 { first } else { keys[i - 1].frame + 1 };
         for (to, out, dir) in [(ahead, &mut forward, 1i64), (behind, &mut backward, -1)] {
+            if (to - key.frame) * dir <= 0 {
+                continue;
+            }
             let mut trackers = start(kinds, key, frames, settings)?;
             let mut f = key.frame + dir;
             while (f - to) * dir <= 0 {
                 let pyramid = frames.pyramid(f)?;
                 out[(f - first) as usize] = Some(
                     trackers
-                        .iter_mut()
+                        .par_iter_mut()
                         .map(|t| t.step(&pyramid, settings))
                         .collect(),
                 );

@@ -274,7 +274,12 @@ impl Template {
             if !(warp.c.is_finite() && warp.plausible()) {
                 return false;
             }
-            let small = p[0].abs().max(p[1].abs()) < 1e-3 && p[2..].iter().all(|v| v.abs() < 1e-5);
+            // Converged when the step moves no part of the patch by more
+            // than a hundredth of a pixel (coarse levels: a tenth; the
+            // finest level refines).
+            let reach = p[2..].iter().fold(0.0f64, |m, v| m.max(v.abs())) * self.radius as f64;
+            let tolerance = if k == 0 { 0.01 } else { 0.1 };
+            let small = p[0].abs().max(p[1].abs()) + reach < tolerance;
             if small {
                 break;
             }
