@@ -292,3 +292,148 @@ fn morphfx_track_refuses_bad_input_with_exit_2_and_writes_nothing() {
     assert!(msg.contains("no keyframes"), "{msg}");
     assert!(!out.exists(), "nothing written on failure");
 }
+
+/// A shot of a textured plate under an affine motion, frames 0 ..= 10, as a
+/// host clip that knows its range.
+struct Shot {
+    frames: Vec<Arc<morphfx_harness::host::Frame>>,
+}
+
+impl morphfx_harness::host::FrameSource for Shot {
+    fn frame(&self, time: f64) -> Result<Arc<morphfx_harness::host::Frame>, String> {
+        self.frames
+            .get(time as usize)
+            .cloned()
+            .ok_or_else(|| format!("no frame {time}"))
+    }
+    fn range(&self) -> Option<(f64, f64)> {
+        Some((0.0, self.frames.len() as f64 - 1.0))
+    }
+}
+
+fn button_motion() -> ShotMotion {
+    ShotMotion {
+        frames: 10,
+        centre: Vec2::new(96.0, 80.0),
+        rotate_deg: 5.0,
+        zoom: 1.04,
+        drift: Vec2::new(10.0, 6.0),
+        bend: Vec2::ZERO,
+        bend_at: Vec2::ZERO,
+        bend_radius: 1.0,
+    }
+}
+
+fn shot(depth: &str, motion: &ShotMotion) -> Arc<Shot> {
+    let plate = Image::from_fn(morphfx::geom::RectI::from_size(192, 160), 3, |i, j, c| {
+        morphfx::testing::texture(Vec2::new(i as f64 + 0.5, j as f64 + 0.5))[c]
+    });
+    Arc::new(Shot {
+        frames: (0..=motion.frames)
+            .map(|f| {
+                let img = shot_frame(&plate, motion, f, 0.0, 0.0, 3);
+                Arc::new(morphfx_harness::host::Frame::from_image(&img, depth, false))
+            })
+            .collect(),
+    })
+}
+
+fn point_at(inst: &morphfx_harness::host::Instance<'_>, id: &str, t: f64) -> Vec2 {
+    let v = inst.doubles_at(id, t).unwrap();
+    Vec2::new(v[0], v[1])
+}
+
+#[test]
+fn track_forward_keys_both_sides_to_the_end_of_the_clip_with_progress() {
+    for depth in ["OfxBitDepthByte", "OfxBitDepthFloat"] {
+        let motion = button_motion();
+        let inst = common::bundle()
+            .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+            .unwrap();
+        let source = shot(depth, &motion);
+        inst.connect("SourceA", source.clone()).unwrap();
+        inst.connect("SourceB", source).unwrap();
+        inst.set_int("line_count", 1).unwrap();
+        let (a, b) = (
+            [Vec2::new(60.0, 50.0), Vec2::new(120.0, 95.0)],
+            [Vec2::new(70.0, 110.0), Vec2::new(130.0, 60.0)],
+        );
+        for (id, p) in [
+            ("a_start", a[0]),
+            ("a_end", a[1]),
+            ("b_start", b[0]),
+            ("b_end", b[1]),
+        ] {
+            inst.set_double(&format!("line1_{id}"), &[p.x, p.y], Some(0.0))
+                .unwrap();
+        }
+        morphfx_harness::host::params::take_edit_log();
+        inst.instance_changed("track_forward", 0.0).unwrap();
+        // One undo step holding a key per end per frame 1 ..= 10.
+        let log = morphfx_harness::host::params::take_edit_log();
+        assert_eq!(
+            log.first().map(String::as_str),
+            Some("begin Track Forward"),
+            "{log:?}"
+        );
+        assert_eq!(log.len(), 2 + 4 * 10, "{log:?}");
+        for (id, key) in [
+            ("a_start", a[0]),
+            ("a_end", a[1]),
+            ("b_start", b[0]),
+            ("b_end", b[1]),
+        ] {
+            let id = format!("line1_{id}");
+            let times = inst.key_times(&id).unwrap();
+            assert_eq!(times, (0..=10).map(f64::from).collect::<Vec<_>>(), "{id}");
+            for f in 1..=10 {
+                let err = point_at(&inst, &id, f as f64).distance(motion.at(f, key));
+                assert!(err < 0.3, "{depth} {id} frame {f}: {err} px off");
+            }
+        }
+        let (progress, open) = inst.progress_log();
+        assert!(!open, "the progress task was closed");
+        assert!(progress.windows(2).all(|w| w[0] < w[1]), "{progress:?}");
+        assert_eq!(progress.last(), Some(&1.0));
+    }
+}
+
+#[test]
+fn track_stops_before_the_next_key_goes_backward_and_cancel_keeps_what_was_made() {
+    let motion = button_motion();
+    let inst = common::bundle()
+        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
+        .unwrap();
+    inst.connect("Source", shot("OfxBitDepthFloat", &motion))
+        .unwrap();
+    inst.set_int("line_count", 1).unwrap();
+    let line = [Vec2::new(60.0, 50.0), Vec2::new(120.0, 95.0)];
+    for (id, p) in [("a_start", line[0]), ("a_end", line[1])] {
+        // Keys at 3 (tracked from) and 8 (a user's, kept).
+        for f in [3usize, 8] {
+            let q = motion.at(f, p);
+            inst.set_double(&format!("line1_{id}"), &[q.x, q.y], Some(f as f64))
+                .unwrap();
+        }
+    }
+    inst.instance_changed("track_forward", 3.0).unwrap();
+    assert_eq!(
+        inst.key_times("line1_a_end").unwrap(),
+        [3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
+    );
+    inst.instance_changed("track_backward", 3.0).unwrap();
+    let times = inst.key_times("line1_a_start").unwrap();
+    assert_eq!(times, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
+    for f in [0usize, 1, 2, 5] {
+        let err = point_at(&inst, "line1_a_start", f as f64).distance(motion.at(f, line[0]));
+        assert!(err < 0.3, "frame {f}: {err}");
+    }
+    // From 8 to the clip's end, 10: cancel pressed as the first of the two
+    // frames reports; its keys stay, frame 10 is never keyed.
+    inst.cancel_progress_at(Some(0.3));
+    inst.instance_changed("track_forward", 8.0).unwrap();
+    let after = inst.key_times("line1_a_end").unwrap();
+    assert_eq!(after.last(), Some(&9.0), "{after:?}");
+    assert_eq!(inst.progress_log().0.last(), Some(&0.5));
+    inst.cancel_progress_at(None);
+}

@@ -21,6 +21,12 @@ pub trait FrameSource: Send + Sync {
     /// The frame at `time` at render scale 1, or why there is none.
     fn frame(&self, time: f64) -> Result<Arc<Frame>, String>;
 
+    /// The frames it has images for, when it knows (a sequence); the
+    /// clip's `kOfxImageEffectPropFrameRange`.
+    fn range(&self) -> Option<(f64, f64)> {
+        None
+    }
+
     /// Whether the clip's region of definition is infinite (the spec allows
     /// it: a constant or a Roto upstream) while its images stay finite.
     fn infinite(&self) -> bool {
@@ -74,6 +80,10 @@ pub struct Effect {
     pub timeline: Mutex<(f64, f64, f64)>,
     /// Progress the plugin last reported (progress suite), if a task is open.
     pub progress: Mutex<Option<(String, f64)>>,
+    /// Every progress the plugin reported, in order (tests read it).
+    pub progress_log: Mutex<Vec<f64>>,
+    /// The user presses cancel once progress reaches this.
+    pub cancel_at: Mutex<Option<f64>>,
     /// The persistent message the plugin set (message suite v2), until it
     /// clears it: what a host shows on the node (Natron draws it red).
     pub persistent: Mutex<Option<Message>>,
@@ -93,6 +103,8 @@ impl Effect {
             field_order: Mutex::new(None),
             timeline: Mutex::new((0.0, 0.0, 0.0)),
             progress: Mutex::new(None),
+            progress_log: Mutex::new(Vec::new()),
+            cancel_at: Mutex::new(None),
             persistent: Mutex::new(None),
         });
         LIVE_EFFECTS

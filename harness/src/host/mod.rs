@@ -614,6 +614,11 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// The times of a param's keys, in order.
+    pub fn key_times(&self, name: &str) -> Result<Vec<f64>, HostError> {
+        Ok(self.param(name)?.key_times())
+    }
+
     /// The values of a double-valued param at `time` (keys interpolated).
     pub fn doubles_at(&self, name: &str, time: f64) -> Result<Vec<f64>, HostError> {
         let p = self.param(name)?;
@@ -622,6 +627,34 @@ impl Instance<'_> {
             _ => return Err(HostError::bad(format!("{name} is not a double param"))),
         };
         Ok(p.value_at(time).d[..n].to_vec())
+    }
+
+    /// The user will press cancel on the plugin's progress bar once it
+    /// reaches `at` (`None`: never).
+    pub fn cancel_progress_at(&self, at: Option<f64>) {
+        *self
+            .effect
+            .cancel_at
+            .lock()
+            .unwrap_or_else(|e| e.into_inner()) = at;
+    }
+
+    /// Every progress the plugin reported so far, and whether a progress
+    /// task is still open.
+    pub fn progress_log(&self) -> (Vec<f64>, bool) {
+        let log = self
+            .effect
+            .progress_log
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        let open = self
+            .effect
+            .progress
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .is_some();
+        (log, open)
     }
 
     /// Tells the plugin the user changed (or pressed) param `name` at `time`.
@@ -682,6 +715,10 @@ impl Instance<'_> {
             .effect
             .clip(clip)
             .ok_or_else(|| HostError::bad(format!("the plugin has no clip {clip}")))?;
+        if let Some((first, last)) = source.range() {
+            c.props
+                .set_double(kOfxImageEffectPropFrameRange, &[first, last]);
+        }
         *c.source.lock().unwrap_or_else(|e| e.into_inner()) = Some(source);
         c.props.set_int(kOfxImageClipPropConnected, &[1]);
         Ok(())

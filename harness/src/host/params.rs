@@ -135,6 +135,11 @@ impl Param {
     pub fn num_keys(&self) -> usize {
         self.state().1.len()
     }
+
+    /// The times of its keys, in order.
+    pub fn key_times(&self) -> Vec<f64> {
+        self.state().1.iter().map(|k| k.0).collect()
+    }
 }
 
 #[derive(Default)]
@@ -290,12 +295,20 @@ unsafe extern "C" fn num_keys(h: OfxParamHandle, n: *mut c_uint) -> OfxStatus {
     kOfxStatOK
 }
 
-unsafe extern "C" fn unsupported_key_time(
-    _: OfxParamHandle,
-    _: c_uint,
-    _: *mut OfxTime,
-) -> OfxStatus {
-    kOfxStatErrUnsupported
+unsafe extern "C" fn key_time(h: OfxParamHandle, nth: c_uint, time: *mut OfxTime) -> OfxStatus {
+    // SAFETY: see `param_of`.
+    let Some(p) = (unsafe { param_of(h) }) else {
+        return kOfxStatErrBadHandle;
+    };
+    match p.key_times().get(nth as usize) {
+        None => kOfxStatErrBadIndex,
+        Some(_) if time.is_null() => kOfxStatErrBadIndex,
+        Some(t) => {
+            // SAFETY: checked non-null; the plugin's own variable.
+            unsafe { *time = *t };
+            kOfxStatOK
+        }
+    }
 }
 unsafe extern "C" fn unsupported_key_index(
     _: OfxParamHandle,
@@ -540,7 +553,7 @@ pub static SUITE: OfxParameterSuiteV1 = OfxParameterSuiteV1 {
     paramSetValue: Some(mfx_paramSetValue),
     paramSetValueAtTime: Some(mfx_paramSetValueAtTime),
     paramGetNumKeys: Some(num_keys),
-    paramGetKeyTime: Some(unsupported_key_time),
+    paramGetKeyTime: Some(key_time),
     paramGetKeyIndex: Some(unsupported_key_index),
     paramDeleteKey: Some(unsupported_delete_key),
     paramDeleteAllKeys: Some(delete_all_keys),

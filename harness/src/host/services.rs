@@ -280,7 +280,14 @@ unsafe extern "C" fn progress_update(instance: *mut c_void, progress: f64) -> Of
     {
         Some(task) => {
             task.1 = progress.clamp(0.0, 1.0);
-            kOfxStatOK
+            e.progress_log
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(task.1);
+            match *e.cancel_at.lock().unwrap_or_else(|p| p.into_inner()) {
+                Some(at) if task.1 >= at => kOfxStatReplyNo,
+                _ => kOfxStatOK,
+            }
         }
         None => kOfxStatFailed,
     }

@@ -9,6 +9,7 @@ pub mod params;
 mod render;
 mod snap;
 pub mod spec;
+mod track;
 pub mod warp;
 
 use std::ffi::CStr;
@@ -130,6 +131,10 @@ fn instance_changed(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outco
     let time = in_args.get_double(kOfxPropTime, 0)?;
     if name == params::SNAP_LINES {
         snap::snap_lines(kind, effect, time)
+    } else if name == params::TRACK_FORWARD {
+        track::track_lines(kind, effect, time, 1)
+    } else if name == params::TRACK_BACKWARD {
+        track::track_lines(kind, effect, time, -1)
     } else if name == params::LINE_COUNT {
         lines::hide_unused(kind, instance::get(effect)?.params()?, time);
         Ok(())

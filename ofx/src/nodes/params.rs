@@ -48,6 +48,8 @@ pub const VIEW: &str = "view";
 pub const MESH_PASS: &str = "mesh_pass";
 pub const SNAP_LINES: &str = "snap_lines";
 pub const SNAP_SIGMA: &str = "snap_sigma";
+pub const TRACK_FORWARD: &str = "track_forward";
+pub const TRACK_BACKWARD: &str = "track_backward";
 pub const OVERLAY_SHOW: &str = "overlay_show";
 pub const OVERLAY_EDIT: &str = "overlay_edit";
 pub const AUTO_LEVELS: &str = "auto_levels";
@@ -294,6 +296,8 @@ fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
         ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(SNAP_SIGMA, "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Kind::Double { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group("lines_group").animated(false),
+        ParamSpec::new(TRACK_FORWARD, "Track Forward", "Follows every enabled line through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(TRACK_BACKWARD, "Track Backward", "As Track Forward, towards the start: to the previous key, or the first frame of the clip.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(OVERLAY_SHOW, "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", choice(Show::Both)).in_group("lines_group").animated(false),
         ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which lines the pen moves in the viewer. Drag an end, or a line by its middle; drag in empty space to draw a new line. Hold Shift to grab only A's lines, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
     ];

@@ -115,6 +115,35 @@ impl Effect {
         }
     }
 
+    /// Opens the host's progress bar for a long task (a no-op without the
+    /// progress suite).
+    pub fn progress_start(&self, label: &str) {
+        let Some(f) = self.suites.progress.and_then(|s| s.progressStart) else {
+            return;
+        };
+        let label = CString::new(label.replace('\0', " ")).unwrap_or_default();
+        // SAFETY: the host's function, given our instance handle and a C string.
+        unsafe { f(self.handle as *mut c_void, label.as_ptr()) };
+    }
+
+    /// Reports `done` in `[0, 1]`; false when the user pressed cancel
+    /// (`kOfxStatReplyNo`).
+    pub fn progress_update(&self, done: f64) -> bool {
+        let Some(f) = self.suites.progress.and_then(|s| s.progressUpdate) else {
+            return true;
+        };
+        // SAFETY: the host's function, given our instance handle.
+        unsafe { f(self.handle as *mut c_void, done) != kOfxStatReplyNo }
+    }
+
+    /// Closes the progress bar `progress_start` opened.
+    pub fn progress_end(&self) {
+        if let Some(f) = self.suites.progress.and_then(|s| s.progressEnd) {
+            // SAFETY: the host's function, given our instance handle.
+            unsafe { f(self.handle as *mut c_void) };
+        }
+    }
+
     /// Posts a message through the host's message suite (if it has one).
     pub fn message(&self, kind: &CStr, id: &CStr, text: &str) {
         let Some(suite) = self.suites.message else {
@@ -200,6 +229,17 @@ impl Clip {
             .and_then(|p| p.get_int(kOfxImageClipPropConnected, 0))
             .map(|c| c != 0)
             .unwrap_or(false)
+    }
+
+    /// The frames the clip has images for (`kOfxImageEffectPropFrameRange`),
+    /// when the host says.
+    pub fn frame_range(&self) -> Option<(f64, f64)> {
+        let [a, b] = self
+            .props()
+            .ok()?
+            .get_doubles(kOfxImageEffectPropFrameRange)
+            .ok()?;
+        (a.is_finite() && b.is_finite() && a <= b).then_some((a, b))
     }
 
     /// Region of definition at `time`, canonical coordinates.

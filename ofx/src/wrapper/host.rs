@@ -11,6 +11,7 @@ use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::interact::*;
 use openfx::sys::image_effect_v1::message::*;
 use openfx::sys::image_effect_v1::param::*;
+use openfx::sys::image_effect_v1::progress::*;
 
 use super::{Failure, Outcome};
 
@@ -26,6 +27,8 @@ pub struct Suites {
     pub interact: Option<&'static OfxInteractSuiteV1>,
     /// OFX 1.5 drawing without OpenGL (overlays).
     pub draw: Option<&'static OfxDrawSuiteV1>,
+    /// Progress of long work outside renders (tracking), with cancel.
+    pub progress: Option<&'static OfxProgressSuiteV1>,
 }
 
 // SAFETY: the suites are immutable function tables the host keeps alive for as
@@ -90,6 +93,7 @@ pub fn load() -> Outcome {
     let message_v2 = get(kOfxMessageSuite, 2) as *const OfxMessageSuiteV2;
     let interact = get(kOfxInteractSuite, 1) as *const OfxInteractSuiteV1;
     let draw = get(kOfxDrawSuite, 1) as *const OfxDrawSuiteV1;
+    let progress = get(kOfxProgressSuite, 1) as *const OfxProgressSuiteV1;
     // SAFETY: the host returned these pointers for the named suite versions;
     // they stay valid until the binary is unloaded.
     let suites = unsafe {
@@ -101,6 +105,7 @@ pub fn load() -> Outcome {
             message_v2: message_v2.as_ref(),
             interact: interact.as_ref(),
             draw: draw.as_ref(),
+            progress: progress.as_ref(),
         }
     };
     switches();

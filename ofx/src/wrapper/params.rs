@@ -328,6 +328,22 @@ impl Params {
         Ok(n)
     }
 
+    /// The times of the param's keys, in order.
+    pub fn key_times(&self, id: &str) -> Outcome<Vec<f64>> {
+        let n = self.num_keys(id)?;
+        let f = need(self.set.suite.paramGetKeyTime, "paramGetKeyTime")?;
+        let h = self.handle(id)?;
+        (0..n)
+            .map(|k| {
+                let mut t = 0.0;
+                // SAFETY: the param's handle, a key index below its count
+                // and a live out-pointer.
+                check(unsafe { f(h, k, &mut t) }, &format!("key {k} of {id}"))?;
+                Ok(t)
+            })
+            .collect()
+    }
+
     /// Removes every key of the param (its value stays what it was).
     pub fn delete_all_keys(&self, id: &str) -> Outcome {
         let f = need(self.set.suite.paramDeleteAllKeys, "paramDeleteAllKeys")?;

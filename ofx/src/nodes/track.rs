@@ -1,0 +1,247 @@
+//! The Track Forward and Track Backward push-buttons: every enabled line
+//! slot followed through its source from the current frame, one frame at a
+//! time, to the slot's next key in that direction (or the end of the clip),
+//! keyed at each frame: A's ends on Source A, B's on Source B (Morph).
+//!
+//! The core's tracker does the work (docs/tracking.md): each frame is
+//! matched against the current frame's picture, so nothing drifts. A line
+//! that loses track is keyed no further, and named in a message at the end.
+//! The host's progress bar shows the frames; cancel keeps the keys made.
+
+use std::sync::Arc;
+
+use morphfx::features::{FeatureKind, Side};
+use morphfx::geom::{PixelScale, Vec2};
+use morphfx::track::{Grey, Pyramid, SideTracker, TrackSettings};
+
+use super::lines::{end_id, slot_lines, SlotLine};
+use super::params::{Reader, Settings};
+use super::render::context;
+use super::{instance, NodeKind};
+use crate::wrapper::clips::{Depth, Effect};
+use crate::wrapper::params::Params;
+use crate::wrapper::{Failure, Outcome};
+
+/// Frames tracked at most when neither keys nor the clip say where to stop.
+const MAX_FRAMES: i64 = 10_000;
+
+/// One side of one slot being tracked.
+struct Follower {
+    slot: usize,
+    side: Side,
+    tracker: SideTracker,
+    /// The first frame it lost track at, after which it is keyed no more.
+    lost_at: Option<f64>,
+}
+
+/// A source clip and its frame offset, with the pixel scale of its images.
+struct Source<'e> {
+    effect: &'e Effect,
+    clip: &'static str,
+    offset: f64,
+}
+
+impl Source<'_> {
+    /// The pyramid of the source at node time `time`, and the scale its
+    /// pixels are at; `None` when the clip has no image there.
+    fn pyramid(&self, time: f64, levels: usize) -> Outcome<Option<(Arc<Pyramid>, PixelScale)>> {
+        let Some(image) = self.effect.clip(self.clip)?.image(time + self.offset)? else {
+            return Ok(None);
+        };
+        let info = image.info();
+        let scale = PixelScale::new(info.render_scale.0, info.render_scale.1, info.par);
+        let grey = match info.depth {
+            Depth::U8 => Grey::from_view(&image.view::<u8>()?),
+            Depth::U16 => Grey::from_view(&image.view::<u16>()?),
+            Depth::F32 => Grey::from_view(&image.view::<f32>()?),
+        };
+        Ok(Some((Arc::new(Pyramid::new(grey, levels, 16)), scale)))
+    }
+}
+
+/// A Track button pressed at `time`: `step` is 1 (forward) or -1.
+pub fn track_lines(kind: NodeKind, effect: &Effect, time: f64, step: i64) -> Outcome {
+    let instance = instance::get(effect)?;
+    let params = instance.params()?;
+    let lines = slot_lines(&Reader::new(params, kind, time));
+    if lines.is_empty() {
+        return Ok(());
+    }
+    let sources = sources(kind, effect, params, time)?;
+    let stop = stop_frame(params, effect, &sources, &lines, time, step);
+    let settings = TrackSettings::default();
+    let mut followers = Vec::new();
+    for (side, source) in &sources {
+        let (key, scale) = source.pyramid(time, settings.levels)?.ok_or_else(|| {
+            Failure::BadInput(format!(
+                "Track: clip {} has no image at frame {time}",
+                source.clip
+            ))
+        })?;
+        for line in &lines {
+            let ends = line.side(*side).map(|p| scale.to_pixel(p));
+            followers.push(Follower {
+                slot: line.slot,
+                side: *side,
+                tracker: SideTracker::new(FeatureKind::Line, &ends, &key, &settings),
+                lost_at: None,
+            });
+        }
+    }
+    let label = if step > 0 {
+        "Track Forward"
+    } else {
+        "Track Backward"
+    };
+    effect.progress_start(label);
+    let result = params.edit_block(label, || {
+        sweep(
+            effect,
+            params,
+            &sources,
+            &mut followers,
+            (time, stop, step),
+            &settings,
+        )
+    });
+    effect.progress_end();
+    instance.purge();
+    result?;
+    report_lost(effect, &followers);
+    Ok(())
+}
+
+/// The node's sources with their sides and frame offsets, each connected.
+fn sources<'e>(
+    kind: NodeKind,
+    effect: &'e Effect,
+    params: &Params,
+    time: f64,
+) -> Outcome<Vec<(Side, Source<'e>)>> {
+    let settings = Settings::read(params, time, kind);
+    let (a, b) = kind.source_clips(&context(effect));
+    let mut out = vec![(Side::A, a, settings.offset_a)];
+    out.extend(b.map(|b| (Side::B, b, settings.offset_b)));
+    out.into_iter()
+        .map(|(side, clip, offset)| {
+            if !effect.clip(clip)?.is_connected() {
+                return Err(Failure::BadInput(format!(
+                    "Track needs clip {clip} connected"
+                )));
+            }
+            Ok((
+                side,
+                Source {
+                    effect,
+                    clip,
+                    offset: offset as f64,
+                },
+            ))
+        })
+        .collect()
+}
+
+/// The last frame to key: before the nearest key of any tracked end beyond
+/// `time`, else the clip's last (or first) frame.
+fn stop_frame(
+    params: &Params,
+    effect: &Effect,
+    sources: &[(Side, Source<'_>)],
+    lines: &[SlotLine],
+    time: f64,
+    step: i64,
+) -> f64 {
+    let dir = step as f64;
+    let next_key = sources
+        .iter()
+        .flat_map(|(side, _)| lines.iter().map(move |l| (l.slot, *side)))
+        .flat_map(|(slot, side)| (0..2).map(move |end| end_id(slot, side, end)))
+        // A host that cannot list keys: the clip's end decides.
+        .flat_map(|id| params.key_times(&id).unwrap_or_default())
+        .filter(|t| (t - time) * dir > 0.5)
+        .min_by(|x, y| ((x - time) * dir).total_cmp(&((y - time) * dir)));
+    if let Some(key) = next_key {
+        return key - dir;
+    }
+    let range = sources
+        .iter()
+        .filter_map(|(_, s)| {
+            let (a, b) = effect.clip(s.clip).ok()?.frame_range()?;
+            Some((a - s.offset, b - s.offset))
+        })
+        .reduce(|x, y| (x.0.max(y.0), x.1.min(y.1)));
+    match range {
+        Some((first, last)) => {
+            if step > 0 {
+                last
+            } else {
+                first
+            }
+        }
+        None => time + dir * MAX_FRAMES as f64,
+    }
+}
+
+/// Frames `time + step` to `stop`: track, key, report progress.
+fn sweep(
+    effect: &Effect,
+    params: &Params,
+    sources: &[(Side, Source<'_>)],
+    followers: &mut [Follower],
+    (time, stop, step): (f64, f64, i64),
+    settings: &TrackSettings,
+) -> Outcome {
+    let total = ((stop - time) * step as f64).round().max(0.0) as i64;
+    for n in 1..=total {
+        let frame = time + (n * step) as f64;
+        for (side, source) in sources {
+            // A clip that ends early (no image) ends the sweep.
+            let Some((pyramid, scale)) = source.pyramid(frame, settings.levels)? else {
+                return Ok(());
+            };
+            for f in followers
+                .iter_mut()
+                .filter(|f| f.side == *side && f.lost_at.is_none())
+            {
+                let e = f.tracker.step(&pyramid, settings);
+                if e.lost.iter().any(|l| *l) {
+                    f.lost_at = Some(frame);
+                    continue;
+                }
+                for (end, p) in e.points.iter().enumerate() {
+                    let at = Vec2::new(p.x / scale.x, p.y / scale.y);
+                    params.set_point_at(&end_id(f.slot, f.side, end), frame, (at.x, at.y))?;
+                }
+            }
+        }
+        if followers.iter().all(|f| f.lost_at.is_some())
+            || !effect.progress_update(n as f64 / total as f64)
+        {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// Names each line that lost track, and where.
+fn report_lost(effect: &Effect, followers: &[Follower]) {
+    let lost: Vec<String> = followers
+        .iter()
+        .filter_map(|f| {
+            let side = if f.side == Side::A { "A" } else { "B" };
+            f.lost_at
+                .map(|t| format!("line {} on {side} at frame {t}", f.slot))
+        })
+        .collect();
+    if !lost.is_empty() {
+        effect.message(
+            openfx::sys::image_effect_v1::message::kOfxMessageWarning,
+            c"net.morphfx.track.lost",
+            &format!(
+                "Track lost {} (not keyed from there: key it by hand and track again): {}",
+                if lost.len() == 1 { "a line" } else { "lines" },
+                lost.join(", ")
+            ),
+        );
+    }
+}
