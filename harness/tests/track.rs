@@ -325,13 +325,30 @@ fn button_motion() -> ShotMotion {
 }
 
 fn shot(depth: &str, motion: &ShotMotion) -> Arc<Shot> {
+    covered_shot(depth, motion, |_, _| false)
+}
+
+/// As `shot`, flat grey wherever `covered(frame, position)`.
+fn covered_shot(
+    depth: &str,
+    motion: &ShotMotion,
+    covered: impl Fn(usize, Vec2) -> bool,
+) -> Arc<Shot> {
     let plate = Image::from_fn(morphfx::geom::RectI::from_size(192, 160), 3, |i, j, c| {
         morphfx::testing::texture(Vec2::new(i as f64 + 0.5, j as f64 + 0.5))[c]
     });
     Arc::new(Shot {
         frames: (0..=motion.frames)
             .map(|f| {
-                let img = shot_frame(&plate, motion, f, 0.0, 0.0, 3);
+                let mut img = shot_frame(&plate, motion, f, 0.0, 0.0, 3);
+                for j in 0..160 {
+                    for i in 0..192 {
+                        if covered(f, Vec2::new(i as f64 + 0.5, j as f64 + 0.5)) {
+                            let k = (j * 192 + i) * 4;
+                            img.data[k..k + 3].copy_from_slice(&[0.3; 3]);
+                        }
+                    }
+                }
                 Arc::new(morphfx_harness::host::Frame::from_image(&img, depth, false))
             })
             .collect(),
@@ -436,4 +453,33 @@ fn track_stops_before_the_next_key_goes_backward_and_cancel_keeps_what_was_made(
     assert_eq!(after.last(), Some(&9.0), "{after:?}");
     assert_eq!(inst.progress_log().0.last(), Some(&0.5));
     inst.cancel_progress_at(None);
+}
+
+#[test]
+fn track_keys_no_further_than_a_line_is_seen_and_names_where_it_lost_it() {
+    let motion = button_motion();
+    let line = [Vec2::new(60.0, 50.0), Vec2::new(120.0, 95.0)];
+    // From frame 6 on, a flat card covers the whole line.
+    let card = |f: usize, p: Vec2| f >= 6 && p.x > 40.0 && p.x < 150.0 && p.y > 30.0 && p.y < 125.0;
+    let inst = common::bundle()
+        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
+        .unwrap();
+    inst.connect("Source", covered_shot("OfxBitDepthFloat", &motion, card))
+        .unwrap();
+    inst.set_int("line_count", 1).unwrap();
+    for (id, p) in [("a_start", line[0]), ("a_end", line[1])] {
+        inst.set_double(&format!("line1_{id}"), &[p.x, p.y], Some(0.0))
+            .unwrap();
+    }
+    inst.take_messages();
+    inst.instance_changed("track_forward", 0.0).unwrap();
+    assert_eq!(
+        inst.key_times("line1_a_start").unwrap(),
+        [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    );
+    let said: Vec<String> = inst.take_messages().into_iter().map(|m| m.text).collect();
+    assert!(
+        said.iter().any(|t| t.contains("line 1 on A at frame 6")),
+        "{said:?}"
+    );
 }

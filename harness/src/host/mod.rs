@@ -614,6 +614,11 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// The messages the plugin posted since the last call (message suite).
+    pub fn take_messages(&self) -> Vec<Message> {
+        self.effect.take_messages()
+    }
+
     /// The times of a param's keys, in order.
     pub fn key_times(&self, name: &str) -> Result<Vec<f64>, HostError> {
         Ok(self.param(name)?.key_times())
