@@ -1,5 +1,8 @@
-//! Frame IO. EXR is read and written at full precision (half or float); PNG,
-//! JPEG and TIFF are read (their code values kept as they are, not linearised).
+//! Frame IO. EXR is read and written at full precision (half or float), as
+//! linear light. PNG, JPEG and TIFF with 8- or 16-bit samples hold sRGB code
+//! values: they are decoded to linear on read and PNG is encoded to sRGB on
+//! write, as a compositor's Read and Write nodes do, unless the caller asks
+//! for the raw code values ([`Colour::Raw`]); float TIFF is linear already.
 //! Outputs go to a temporary name and are renamed when complete.
 
 use std::path::Path;
@@ -42,7 +45,41 @@ pub struct DisplayWindow {
     pub origin: (i32, i32),
 }
 
+/// What 8- and 16-bit PNG, JPEG and TIFF samples are taken to be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Colour {
+    /// sRGB-encoded: decoded to linear light on read, encoded on write.
+    #[default]
+    Srgb,
+    /// Code values kept as they are (`--raw`).
+    Raw,
+}
+
+/// The sRGB decoding of a code value in `[0, 1]` (IEC 61966-2-1).
+pub fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB encoding of linear light, for `[0, 1]`.
+pub fn linear_to_srgb(v: f32) -> f32 {
+    if v <= 0.0031308 {
+        v * 12.92
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// A plate, 8- and 16-bit formats decoded from sRGB.
 pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
+    read_as(path, Colour::Srgb)
+}
+
+/// A plate, 8- and 16-bit formats read as `colour` says.
+pub fn read_as(path: &Path, colour: Colour) -> std::result::Result<Plate, HostError> {
     if !path.exists() {
         return Err(HostError::bad(format!("{}: no such file", path.display())));
     }
@@ -54,18 +91,20 @@ pub fn read(path: &Path) -> std::result::Result<Plate, HostError> {
     if ext == "exr" {
         read_exr(path)
     } else {
-        read_other(path)
+        read_other(path, colour)
     }
 }
 
 /// What an image file's header says.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Header {
     /// The pixel bounds (the data window, canonical).
     pub bounds: RectI,
     pub window: DisplayWindow,
     /// Every channel is half float (an EXR written at half precision).
     pub half: bool,
+    /// How an EXR's pixels are compressed (`None`: not an EXR).
+    pub compression: Option<Compression>,
 }
 
 /// An image file's header only (for checking a whole sequence before
@@ -90,6 +129,7 @@ pub fn probe(path: &Path) -> std::result::Result<Header, HostError> {
             bounds: RectI::from_size(w, h),
             window,
             half: false,
+            compression: None,
         });
     }
     let meta = exr::meta::MetaData::read_from_file(path, false)
@@ -114,6 +154,7 @@ pub fn probe(path: &Path) -> std::result::Result<Header, HostError> {
         bounds: data_bounds(display, pos, (w, h)),
         window,
         half,
+        compression: Some(header.compression),
     })
 }
 
@@ -197,10 +238,22 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
     })
 }
 
-fn read_other(path: &Path) -> std::result::Result<Plate, HostError> {
+fn read_other(path: &Path, colour: Colour) -> std::result::Result<Plate, HostError> {
     let img = ::image::open(path)
         .map_err(|e| HostError::bad(format!("{}: cannot read image: {e}", path.display())))?;
-    let rgba = img.to_rgba32f();
+    let float = matches!(
+        img.color(),
+        ::image::ColorType::Rgb32F | ::image::ColorType::Rgba32F
+    );
+    let decode = colour == Colour::Srgb && !float;
+    let mut rgba = img.to_rgba32f();
+    if decode {
+        for p in rgba.pixels_mut() {
+            for c in &mut p.0[..3] {
+                *c = srgb_to_linear(*c);
+            }
+        }
+    }
     let (w, h) = (rgba.width() as usize, rgba.height() as usize);
     let mut image = Image::new(RectI::from_size(w, h), 4);
     for (x, yr, p) in rgba.enumerate_pixels() {
@@ -219,12 +272,64 @@ pub enum ExrPrecision {
     Half,
 }
 
-/// Writes `plate` (RGBA, or fewer channels) to `path` atomically: a temporary
-/// file in the same folder, renamed over the final name only when complete.
+/// How an output file is written.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutputFormat {
+    /// EXR sample type.
+    pub precision: ExrPrecision,
+    /// EXR compression.
+    pub compression: Compression,
+    /// PNG, JPEG and TIFF: sRGB-encoded or raw code values.
+    pub colour: Colour,
+}
+
+impl OutputFormat {
+    /// `precision`, ZIP (16-line blocks), sRGB for 8-bit formats.
+    pub fn new(precision: ExrPrecision) -> Self {
+        OutputFormat {
+            precision,
+            compression: Compression::ZIP16,
+            colour: Colour::Srgb,
+        }
+    }
+}
+
+/// The compressions `--compression` names, OpenImageIO's names.
+pub const COMPRESSIONS: [(&str, Compression); 9] = [
+    ("none", Compression::Uncompressed),
+    ("rle", Compression::RLE),
+    ("zips", Compression::ZIP1),
+    ("zip", Compression::ZIP16),
+    ("piz", Compression::PIZ),
+    ("pxr24", Compression::PXR24),
+    ("b44", Compression::B44),
+    ("dwaa", Compression::DWAA(None)),
+    ("dwab", Compression::DWAB(None)),
+];
+
+/// The compression named `name` (see [`COMPRESSIONS`]).
+pub fn compression_named(name: &str) -> Option<Compression> {
+    COMPRESSIONS
+        .iter()
+        .find(|(n, _)| n.eq_ignore_ascii_case(name))
+        .map(|(_, c)| *c)
+}
+
+/// Writes `plate` at `precision`, ZIP-compressed; see [`write_as`].
 pub fn write(
     path: &Path,
     plate: &Plate,
     precision: ExrPrecision,
+) -> std::result::Result<(), HostError> {
+    write_as(path, plate, OutputFormat::new(precision))
+}
+
+/// Writes `plate` (RGBA, or fewer channels) to `path` atomically: a temporary
+/// file in the same folder, renamed over the final name only when complete.
+pub fn write_as(
+    path: &Path,
+    plate: &Plate,
+    format: OutputFormat,
 ) -> std::result::Result<(), HostError> {
     let dir = path
         .parent()
@@ -240,8 +345,8 @@ pub fn write(
         .unwrap_or("")
         .to_ascii_lowercase();
     let result = match ext.as_str() {
-        "exr" => write_exr(&tmp, plate, precision),
-        "png" | "tif" | "tiff" | "jpg" | "jpeg" => write_other(&tmp, plate, &ext),
+        "exr" => write_exr(&tmp, plate, format),
+        "png" | "tif" | "tiff" | "jpg" | "jpeg" => write_other(&tmp, plate, &ext, format.colour),
         _ => Err(HostError::bad(format!(
             "{}: unknown output format (use .exr or .png)",
             path.display()
@@ -279,17 +384,16 @@ fn rgba_at(plate: &Plate, x: usize, row_from_top: usize) -> [f32; 4] {
 fn write_exr(
     path: &Path,
     plate: &Plate,
-    precision: ExrPrecision,
+    format: OutputFormat,
 ) -> std::result::Result<(), HostError> {
     let img = &plate.image;
     let (w, h) = (img.width(), img.height());
     let b = img.bounds;
     let dh = plate.size.1 as i32;
     let pixel = |pos: Vec2<usize>| rgba_at(plate, pos.x(), pos.y());
-    // Scan lines, as compositing packages write and read fastest, ZIP in
-    // 16-line blocks (lossless, the common default).
+    // Scan lines, as compositing packages write and read fastest.
     let encoding = Encoding {
-        compression: Compression::ZIP16,
+        compression: format.compression,
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
@@ -312,19 +416,33 @@ fn write_exr(
             image.write().to_file(path).map_err(err)
         }};
     }
-    match precision {
+    match format.precision {
         ExrPrecision::Float => write_with!(|v: f32| v),
         ExrPrecision::Half => write_with!(f16::from_f32),
     }
 }
 
-fn write_other(path: &Path, plate: &Plate, ext: &str) -> std::result::Result<(), HostError> {
+fn write_other(
+    path: &Path,
+    plate: &Plate,
+    ext: &str,
+    colour: Colour,
+) -> std::result::Result<(), HostError> {
     let img = &plate.image;
     let (w, h) = (img.width(), img.height());
     let mut out = ::image::RgbaImage::new(w as u32, h as u32);
+    let code = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
     for (x, y, p) in out.enumerate_pixels_mut() {
         let v = rgba_at(plate, x as usize, y as usize);
-        p.0 = v.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+        p.0 = match colour {
+            Colour::Srgb => [
+                code(linear_to_srgb(v[0])),
+                code(linear_to_srgb(v[1])),
+                code(linear_to_srgb(v[2])),
+                code(v[3]),
+            ],
+            Colour::Raw => v.map(code),
+        };
     }
     let format = match ext {
         "png" => ::image::ImageFormat::Png,

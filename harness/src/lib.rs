@@ -3,6 +3,7 @@
 
 pub mod host;
 pub mod io;
+pub mod pipeline;
 pub mod progress;
 pub mod raster;
 pub mod sequence;

@@ -1,7 +1,9 @@
 //! `morphfx`: render the MorphFX bundle on plates (docs/command-line.md).
 
 use std::path::{Path, PathBuf};
+use std::process::Stdio;
 use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
@@ -15,6 +17,7 @@ use morphfx_harness::host::{
     Bundle, ErrorKind, Frame, FrameSource, HostError, HostOptions, Instance, OutputSpec,
 };
 use morphfx_harness::io::{self, ExrPrecision, Plate};
+use morphfx_harness::pipeline::WriteBehind;
 use morphfx_harness::progress::Progress;
 use morphfx_harness::sequence::{frame_path, is_sequence, parse_frames};
 use morphfx_harness::snap::Snap;
@@ -66,6 +69,51 @@ struct Common {
     /// Write 32-bit float EXR (default: the precision of the first input).
     #[arg(long)]
     float: bool,
+    /// EXR compression: none, rle, zips, zip, piz, pxr24, b44, dwaa, dwab
+    /// (default: the first input's; zip for PNG, JPEG and TIFF inputs).
+    #[arg(long)]
+    compression: Option<String>,
+    /// Keep PNG, JPEG and TIFF code values as they are (default: decode
+    /// their sRGB to linear light on read, encode PNG output to sRGB).
+    #[arg(long)]
+    raw: bool,
+}
+
+impl Common {
+    /// How outputs are written: precision and compression follow the first
+    /// input unless the options say otherwise.
+    fn output_format(&self, inputs: &Inputs) -> Result<io::OutputFormat, HostError> {
+        let precision = if self.half || (inputs.half && !self.float) {
+            ExrPrecision::Half
+        } else {
+            ExrPrecision::Float
+        };
+        let compression = match &self.compression {
+            Some(name) => io::compression_named(name).ok_or_else(|| {
+                let names: Vec<&str> = io::COMPRESSIONS.iter().map(|(n, _)| *n).collect();
+                HostError::bad(format!(
+                    "--compression {name}: expected one of {}",
+                    names.join(", ")
+                ))
+            })?,
+            None => inputs
+                .compression
+                .unwrap_or(io::OutputFormat::new(precision).compression),
+        };
+        Ok(io::OutputFormat {
+            precision,
+            compression,
+            colour: self.colour(),
+        })
+    }
+
+    fn colour(&self) -> io::Colour {
+        if self.raw {
+            io::Colour::Raw
+        } else {
+            io::Colour::Srgb
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -437,7 +485,10 @@ type CachedPlate = (i64, Arc<Frame>, (usize, usize));
 /// Reads frames of a file or sequence on demand.
 struct Plates {
     pattern: String,
+    colour: io::Colour,
     cache: Mutex<Vec<CachedPlate>>,
+    /// A frame being read ahead on another thread.
+    ahead: Mutex<Option<(i64, Reading)>>,
     /// Time spent reading files, for the end-of-run summary.
     read_time: Mutex<Duration>,
     /// The first read that failed: the plugin only learns "no image", so the
@@ -445,35 +496,90 @@ struct Plates {
     error: Mutex<Option<HostError>>,
 }
 
+/// A plate as the host hands it over, with its display window's size.
+type Loaded = (Arc<Frame>, (usize, usize));
+
+/// A plate being read on another thread.
+type Reading = JoinHandle<Result<Loaded, HostError>>;
+
 impl Plates {
-    fn new(pattern: &str) -> Arc<Plates> {
+    fn new(pattern: &str, colour: io::Colour) -> Arc<Plates> {
         Arc::new(Plates {
             pattern: pattern.to_owned(),
+            colour,
             cache: Mutex::new(Vec::new()),
+            ahead: Mutex::new(None),
             read_time: Mutex::new(Duration::ZERO),
             error: Mutex::new(None),
         })
     }
-    fn plate(&self, frame: i64) -> Result<(Arc<Frame>, (usize, usize)), HostError> {
-        let frame = if is_sequence(&self.pattern) { frame } else { 0 };
-        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, f, size)) = cache.iter().find(|(k, _, _)| *k == frame) {
-            return Ok((f.clone(), *size));
+
+    fn file_frame(&self, frame: i64) -> i64 {
+        if is_sequence(&self.pattern) {
+            frame
+        } else {
+            0
         }
+    }
+
+    fn load(&self, frame: i64) -> Result<Loaded, HostError> {
         let path = frame_path(&self.pattern, frame);
         let started = Instant::now();
-        let plate = io::read(&path).inspect_err(|e| {
-            self.error
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .get_or_insert_with(|| e.clone());
-        })?;
+        let plate = io::read_as(&path, self.colour)?;
         *self.read_time.lock().unwrap_or_else(|e| e.into_inner()) += started.elapsed();
         let f = Arc::new(Frame::from_image(&plate.image, "OfxBitDepthFloat", false));
-        cache.retain(|(k, _, _)| (k - frame).abs() <= 2);
-        cache.push((frame, f.clone(), plate.size));
         Ok((f, plate.size))
     }
+
+    /// Starts reading `frame` on another thread, unless it is at hand.
+    fn read_ahead(self: &Arc<Self>, frame: i64) {
+        let frame = self.file_frame(frame);
+        let mut ahead = lock(&self.ahead);
+        // A frame read ahead but never asked for (the plugin did not need
+        // it) is kept in the cache once read, and makes room.
+        if let Some((k, job)) = ahead.take_if(|(_, job)| job.is_finished()) {
+            if let Ok(Ok(loaded)) = job.join() {
+                self.keep(k, &loaded);
+            }
+        }
+        let cached = lock(&self.cache).iter().any(|(k, _, _)| *k == frame);
+        if cached || ahead.is_some() {
+            return;
+        }
+        let me = self.clone();
+        *ahead = Some((frame, std::thread::spawn(move || me.load(frame))));
+    }
+
+    fn plate(&self, frame: i64) -> Result<Loaded, HostError> {
+        let frame = self.file_frame(frame);
+        if let Some((_, f, size)) = lock(&self.cache).iter().find(|(k, _, _)| *k == frame) {
+            return Ok((f.clone(), *size));
+        }
+        let pending = lock(&self.ahead).take_if(|(k, _)| *k == frame);
+        let loaded = match pending {
+            Some((_, job)) => job
+                .join()
+                .map_err(|_| HostError::failed("the plate reader panicked"))?,
+            None => self.load(frame),
+        }
+        .inspect_err(|e| {
+            lock(&self.error).get_or_insert_with(|| e.clone());
+        })?;
+        self.keep(frame, &loaded);
+        Ok(loaded)
+    }
+
+    /// Keeps `frame` at hand, with its neighbours (a render may ask for the
+    /// frames around it); farther frames go.
+    fn keep(&self, frame: i64, (f, size): &Loaded) {
+        let mut cache = lock(&self.cache);
+        cache.retain(|(k, _, _)| (k - frame).abs() <= 2 && *k != frame);
+        cache.push((frame, f.clone(), *size));
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 impl FrameSource for Plates {
@@ -608,7 +714,7 @@ impl Job {
         let plates: Vec<(String, Arc<Plates>)> = self
             .sources
             .iter()
-            .map(|(clip, p)| (clip.clone(), Plates::new(p)))
+            .map(|(clip, p)| (clip.clone(), Plates::new(p, c.colour())))
             .collect();
         let inputs = check_inputs(&plates, &frames)?;
         Ok(Prepared {
@@ -635,17 +741,13 @@ impl Job {
         };
         let overlay = Overlay::new(inst, true)?
             .ok_or_else(|| HostError::failed("the plugin declares no overlay"))?;
-        let precision = if self.common.half || (job.inputs.half && !self.common.float) {
-            ExrPrecision::Half
-        } else {
-            ExrPrecision::Float
-        };
+        let format = self.common.output_format(&job.inputs)?;
         let progress = Progress::new(job.frames.len());
         for (n, &f) in job.frames.iter().enumerate() {
-            let mut plate = io::read(&frame_path(source, f))?;
+            let mut plate = io::read_as(&frame_path(source, f), format.colour)?;
             let calls = overlay.draw(f as f64, (1.0, 1.0))?;
             morphfx_harness::raster::paint(&mut plate.image, &calls, (1.0, 1.0));
-            io::write(&frame_path(&self.common.output, f), &plate, precision)?;
+            io::write_as(&frame_path(&self.common.output, f), &plate, format)?;
             progress.tick(n + 1, f);
         }
         progress.done("overlays drawn");
@@ -721,12 +823,9 @@ impl Job {
         inputs: &Inputs,
     ) -> Result<(), HostError> {
         let c = &self.common;
-        // Half in, half out, unless the user says otherwise.
-        let precision = if c.half || (inputs.half && !c.float) {
-            ExrPrecision::Half
-        } else {
-            ExrPrecision::Float
-        };
+        // Half in, half out, and the input's compression, unless the user
+        // says otherwise.
+        let format = c.output_format(inputs)?;
         let outputs: Vec<(String, String)> = std::iter::once((self.view.clone(), c.output.clone()))
             .chain(self.extra.iter().cloned())
             .collect();
@@ -743,7 +842,9 @@ impl Job {
                 .find_map(|(_, p)| p.error.lock().unwrap_or_else(|p| p.into_inner()).take())
                 .unwrap_or(e)
         };
-        let (run_start, mut writing) = (Instant::now(), Duration::ZERO);
+        let mut rendering = Duration::ZERO;
+        // Frame n is written while frame n + 1 renders.
+        let writer = WriteBehind::new(2);
         let transition = self.context == "OfxImageEffectContextTransition";
         for (n, &f) in frames.iter().enumerate() {
             if transition {
@@ -756,6 +857,12 @@ impl Job {
                 });
                 inst.set_double("Transition", &[t], None)?;
             }
+            // The next frame's plates are read while this one renders.
+            if let Some(&next) = frames.get(n + 1) {
+                for (_, p) in plates {
+                    p.read_ahead(next);
+                }
+            }
             for (view, pattern) in &outputs {
                 inst.set_choice("view", view)?;
                 // Frame after frame on one instance: a sequential render.
@@ -763,32 +870,30 @@ impl Job {
                     sequential: true,
                     ..OutputSpec::default()
                 };
-                let out = inst.render(f as f64, spec).map_err(read_error)?;
                 let started = Instant::now();
+                let out = inst.render(f as f64, spec).map_err(read_error)?;
+                rendering += started.elapsed();
                 let plate = Plate {
                     image: out.to_image(),
                     size: inputs.size,
                     origin: inputs.windows.get(&f).map_or((0, 0), |w| w.origin),
                 };
-                io::write(&frame_path(pattern, f), &plate, precision)?;
-                writing += started.elapsed();
+                writer.write(frame_path(pattern, f), plate, format)?;
             }
             progress.tick(n + 1, f);
         }
+        let writing = writer.finish()?;
         inst.end_sequence(range.0, range.1)?;
-        // Plates are read when the plugin asks for them (inside actions), so
-        // rendering is what remains of the loop.
+        // Reading and writing run on their own threads beside the render;
+        // a render that had to wait for its plates counts that wait.
         let reading: Duration = plates
             .iter()
             .map(|(_, p)| *p.read_time.lock().unwrap_or_else(|e| e.into_inner()))
             .sum();
         progress.done(&format!(
-            "read {:.2} s, render {:.2} s, write {:.2} s",
+            "render {:.2} s (waits for plates included); alongside it, read {:.2} s, write {:.2} s",
+            rendering.as_secs_f64(),
             reading.as_secs_f64(),
-            run_start
-                .elapsed()
-                .saturating_sub(reading + writing)
-                .as_secs_f64(),
             writing.as_secs_f64()
         ));
         Ok(())
@@ -811,6 +916,8 @@ struct Inputs {
     size: (usize, usize),
     /// The first input is half float.
     half: bool,
+    /// The first input's EXR compression.
+    compression: Option<exr::prelude::Compression>,
     /// The first source's display window at each frame.
     windows: std::collections::BTreeMap<i64, io::DisplayWindow>,
 }
@@ -824,6 +931,7 @@ struct Inputs {
 fn check_inputs(plates: &[(String, Arc<Plates>)], frames: &[i64]) -> Result<Inputs, HostError> {
     let mut first: Option<((usize, usize), String)> = None;
     let mut half = false;
+    let mut compression = None;
     let mut windows = std::collections::BTreeMap::new();
     for &f in frames {
         for (k, (_, p)) in plates.iter().enumerate() {
@@ -832,7 +940,10 @@ fn check_inputs(plates: &[(String, Arc<Plates>)], frames: &[i64]) -> Result<Inpu
             let (window, s) = (header.window, header.window.size);
             if k == 0 {
                 windows.insert(f, window);
-                half |= first.is_none() && header.half;
+                if first.is_none() {
+                    half = header.half;
+                    compression = header.compression;
+                }
             }
             let name = path.display().to_string();
             match &first {
@@ -850,6 +961,7 @@ fn check_inputs(plates: &[(String, Arc<Plates>)], frames: &[i64]) -> Result<Inpu
     Ok(Inputs {
         size: first.map(|(s, _)| s).unwrap_or_default(),
         half,
+        compression,
         windows,
     })
 }
@@ -888,7 +1000,8 @@ fn bench(
                     f,
                 ),
                 &Plate::new(image, (w, h)),
-                ExrPrecision::Float,
+                // Half float, as camera plates and their scans come.
+                ExrPrecision::Half,
             )?;
         }
     }
@@ -917,6 +1030,7 @@ fn bench(
         .map_err(|e| HostError::failed(format!("{}: {e}", scene_path.display())))?;
     let s = |p: PathBuf| p.to_string_lossy().into_owned();
     eprintln!("rendering the morph of frames 1-{frames}");
+    let started = Instant::now();
     Job {
         plugin: MORPH_ID,
         context: "OfxImageEffectContextGeneral",
@@ -933,10 +1047,44 @@ fn bench(
             frames: Some(format!("1-{frames}")),
             output: s(dir.join("morph.####.exr")),
             half: false,
-            float: true,
+            float: false,
+            compression: None,
+            raw: false,
         },
     }
-    .run(bundle_path)
+    .run(bundle_path)?;
+    let took = started.elapsed().as_secs_f64();
+    compare_with_oiiotool(&plates, frames, took);
+    Ok(())
+}
+
+/// Times OpenImageIO copying sequence A (read and write, no render), when
+/// `oiiotool` is installed, and says how the morph compares: a peer run on
+/// the same machine, in the same run.
+fn compare_with_oiiotool(plates: &Path, frames: usize, morph_secs: f64) {
+    let copy = plates.with_file_name("oiiotool-copy");
+    let _ = std::fs::create_dir_all(&copy);
+    let started = Instant::now();
+    let status = std::process::Command::new("oiiotool")
+        .arg("--frames")
+        .arg(format!("1-{frames}"))
+        .arg(plates.join("a.#.exr"))
+        .arg("-o")
+        .arg(copy.join("a.#.exr"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
+    match status {
+        Ok(s) if s.success() => {
+            let secs = started.elapsed().as_secs_f64();
+            eprintln!(
+                "oiiotool copies sequence A ({frames} frames) in {secs:.2} s: the morph took {:.2}x that",
+                morph_secs / secs.max(1e-9)
+            );
+        }
+        _ => eprintln!("(oiiotool not found: install openimageio-tools to compare with it)"),
+    }
+    let _ = std::fs::remove_dir_all(&copy);
 }
 
 /// Two procedural plates with recognisable features: a warm disc face on A,
@@ -987,6 +1135,8 @@ fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
                     output: s(output),
                     half: false,
                     float: true,
+                    compression: None,
+                    raw: false,
                 },
             }
             .run(bundle_path)

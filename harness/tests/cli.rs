@@ -267,12 +267,14 @@ fn demo_renders_every_built_method_with_exact_end_frames() {
         let first = read(d.join(format!("{method}/morph.0001.png")));
         let last = read(d.join(format!("{method}/morph.0012.png")));
         for (got, want, which) in [(&first, &a, "A"), (&last, &b, "B")] {
-            // PNG holds 8 bits: equal to the plate within one step.
+            // PNG holds 8 sRGB-encoded bits: equal to the plate within one
+            // code step.
+            let code = |v: f32| io::linear_to_srgb(v.clamp(0.0, 1.0));
             let worst = got
                 .data
                 .iter()
                 .zip(&want.data)
-                .map(|(g, w)| (g - w.clamp(0.0, 1.0)).abs())
+                .map(|(g, w)| (code(*g) - code(*w)).abs())
                 .fold(0f32, f32::max);
             assert!(
                 worst <= 1.0 / 255.0 + 1e-6,
@@ -377,5 +379,98 @@ fn plates_with_other_data_windows_morph_over_the_union_in_the_display_window() {
         assert!(text.contains("pixel data origin: x=92, y=12"), "{text}");
         assert!(text.contains("full/display size: 64 x 48"), "{text}");
         assert!(text.contains("full/display origin: 100, 20"), "{text}");
+    }
+}
+
+/// An identity warp: one line, the same on A and B, at t = 0.
+const IDENTITY: &str = "1=10,10,20,10,10,10,20,10";
+
+#[test]
+fn outputs_follow_the_first_inputs_precision_and_compression_unless_told() {
+    use exr::prelude::Compression;
+    let d = tmp("formats");
+    let img = Image::from_fn(RectI::from_size(32, 24), 4, |i, j, c| {
+        (i as f32 * 0.3 + j as f32 * 0.2 + c as f32).sin() + 1.5
+    });
+    let input = d.join("in.exr");
+    let piz = io::OutputFormat {
+        compression: Compression::PIZ,
+        ..io::OutputFormat::new(ExrPrecision::Half)
+    };
+    io::write_as(&input, &Plate::new(img, (32, 24)), piz).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let out = d.join(out);
+        let mut args = vec![
+            "warp",
+            "--line",
+            IDENTITY,
+            "--input",
+            input.to_str().unwrap(),
+        ];
+        args.extend_from_slice(&["--t", "0", "-o", out.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let (code, err) = morphfx(&args);
+        (code, err, out)
+    };
+    let header = |p: &Path| io::probe(p).unwrap();
+    let (code, err, same) = run("same.exr", &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(header(&same).half);
+    assert_eq!(header(&same).compression, Some(Compression::PIZ));
+    // Half in, half out, bit for bit at the identity.
+    assert_eq!(
+        io::read(&same).unwrap().image,
+        io::read(&input).unwrap().image
+    );
+    let (code, err, dwaa) = run("dwaa.exr", &["--compression", "dwaa", "--float"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!header(&dwaa).half);
+    assert!(matches!(
+        header(&dwaa).compression,
+        Some(Compression::DWAA(_))
+    ));
+    let (code, err, bad) = run("bad.exr", &["--compression", "lzw"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--compression lzw") && err.contains("pxr24"),
+        "{err}"
+    );
+    assert!(!bad.exists());
+}
+
+#[test]
+fn png_plates_are_decoded_from_srgb_and_png_outputs_encoded_unless_raw() {
+    let d = tmp("srgb");
+    let png = d.join("grey.png");
+    ::image::RgbaImage::from_pixel(24, 16, ::image::Rgba([128, 64, 255, 255]))
+        .save(&png)
+        .unwrap();
+    let warp = |out: &str, extra: &[&str]| {
+        let out = d.join(out);
+        let mut args = vec!["warp", "--line", IDENTITY, "--input", png.to_str().unwrap()];
+        args.extend_from_slice(&["--t", "0", "-o", out.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let (code, err) = morphfx(&args);
+        assert_eq!(code, 0, "{err}");
+        out
+    };
+    // IEC 61966-2-1: code 128 is 0.21586 of linear light, 64 is 0.05127.
+    let linear = io::read_as(&warp("linear.exr", &[]), io::Colour::Raw)
+        .unwrap()
+        .image;
+    let px = linear.pixel(5, 5);
+    assert!(
+        (px[0] - 0.21586).abs() < 1e-4 && (px[1] - 0.05127).abs() < 1e-4,
+        "{px:?}"
+    );
+    assert_eq!((px[2], px[3]), (1.0, 1.0));
+    let raw = io::read_as(&warp("raw.exr", &["--raw"]), io::Colour::Raw)
+        .unwrap()
+        .image;
+    assert!((raw.pixel(5, 5)[0] - 128.0 / 255.0).abs() < 1e-6);
+    // PNG out: encoded back to the same code values, with and without --raw.
+    for (name, extra) in [("back.png", &[][..]), ("back_raw.png", &["--raw"][..])] {
+        let back = ::image::open(warp(name, extra)).unwrap().to_rgba8();
+        assert_eq!(back.get_pixel(5, 5).0, [128, 64, 255, 255], "{name}");
     }
 }

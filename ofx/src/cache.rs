@@ -2,15 +2,41 @@
 //! (or an `auto` correspondence) depends on, shared by concurrent renders of
 //! the same frame (the second thread waits for the first instead of computing
 //! again), bounded in memory.
+//!
+//! One budget holds for the whole process, every cache of every instance
+//! together (`MORPHFX_CACHE_MB`, default [`DEFAULT_BUDGET_MB`]): when a new
+//! value takes the total over it, the least recently used values go, from
+//! whichever cache holds them. A host with ten nodes then holds no more than
+//! one with one, and a long sequence no more than a short one.
 
 use std::fmt::Debug;
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 use morphfx::image::WarpMap;
 use morphfx::warp::auto::Correspondence;
 
-/// Default memory budget for cached maps (a 1080p map is 16 MiB).
-pub const DEFAULT_BUDGET_BYTES: usize = 512 << 20;
+/// Default process-wide budget, MiB (a 1080p map is 16 MiB).
+pub const DEFAULT_BUDGET_MB: usize = 256;
+
+/// The process-wide budget in bytes: `MORPHFX_CACHE_MB`, else the default.
+fn budget() -> usize {
+    static BUDGET: OnceLock<usize> = OnceLock::new();
+    *BUDGET.get_or_init(|| {
+        let mb = std::env::var("MORPHFX_CACHE_MB")
+            .ok()
+            .and_then(|v| v.trim().parse::<usize>().ok())
+            .unwrap_or(DEFAULT_BUDGET_MB);
+        mb.saturating_mul(1 << 20)
+    })
+}
+
+/// Bytes held by every cache of the process.
+static USED: AtomicUsize = AtomicUsize::new(0);
+/// Ticks on every use, so entries of different caches compare by age.
+static CLOCK: AtomicU64 = AtomicU64::new(0);
+/// Every live cache, for eviction across them.
+static CACHES: Mutex<Vec<Weak<dyn Shrink>>> = Mutex::new(Vec::new());
 
 /// What a cached value costs in memory.
 pub trait Weigh {
@@ -44,16 +70,51 @@ struct Entry<T> {
     last_use: u64,
 }
 
+/// A cache's entries, behind the lock eviction takes.
+struct Entries<T>(Mutex<Vec<Entry<T>>>);
+
+/// A cache as eviction sees it.
+trait Shrink: Send + Sync {
+    /// The last use of its oldest finished entry other than `keep`.
+    fn oldest(&self, keep: Option<&Key>) -> Option<u64>;
+    /// Drops that entry; the bytes it held.
+    fn evict_oldest(&self, keep: Option<&Key>) -> usize;
+}
+
+impl<T: Send + Sync> Shrink for Entries<T> {
+    fn oldest(&self, keep: Option<&Key>) -> Option<u64> {
+        let entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        entries
+            .iter()
+            .filter(|e| e.bytes > 0 && Some(&e.key) != keep)
+            .map(|e| e.last_use)
+            .min()
+    }
+
+    fn evict_oldest(&self, keep: Option<&Key>) -> usize {
+        let mut entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let oldest = entries
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.bytes > 0 && Some(&e.key) != keep)
+            .min_by_key(|(_, e)| e.last_use)
+            .map(|(i, _)| i);
+        match oldest {
+            Some(i) => entries.swap_remove(i).bytes,
+            None => 0,
+        }
+    }
+}
+
 pub struct Cache<T> {
-    entries: Mutex<(Vec<Entry<T>>, u64)>,
-    budget: usize,
+    entries: Arc<Entries<T>>,
 }
 
 pub type WarpCache = Cache<WarpMap>;
 
-impl<T: Weigh> Default for Cache<T> {
+impl<T: Weigh + Send + Sync + 'static> Default for Cache<T> {
     fn default() -> Self {
-        Cache::new(DEFAULT_BUDGET_BYTES)
+        Cache::new()
     }
 }
 
@@ -71,12 +132,14 @@ impl Key {
     }
 }
 
-impl<T: Weigh> Cache<T> {
-    pub fn new(budget: usize) -> Self {
-        Cache {
-            entries: Mutex::new((Vec::new(), 0)),
-            budget,
-        }
+impl<T: Weigh + Send + Sync + 'static> Cache<T> {
+    pub fn new() -> Self {
+        let entries = Arc::new(Entries(Mutex::new(Vec::new())));
+        let weak: Weak<dyn Shrink> = Arc::downgrade(&entries) as Weak<dyn Shrink>;
+        let mut caches = CACHES.lock().unwrap_or_else(|e| e.into_inner());
+        caches.retain(|c| c.strong_count() > 0);
+        caches.push(weak);
+        Cache { entries }
     }
 
     pub fn get_or_compute<E>(
@@ -84,13 +147,12 @@ impl<T: Weigh> Cache<T> {
         key: Key,
         compute: impl FnOnce() -> Result<T, E>,
     ) -> Result<Arc<T>, E> {
+        let now = CLOCK.fetch_add(1, Ordering::Relaxed);
         let slot = {
-            let mut guard = self.entries.lock().unwrap_or_else(|e| e.into_inner());
-            let (entries, clock) = &mut *guard;
-            *clock += 1;
+            let mut entries = self.lock();
             match entries.iter_mut().find(|e| e.key == key) {
                 Some(e) => {
-                    e.last_use = *clock;
+                    e.last_use = now;
                     e.slot.clone()
                 }
                 None => {
@@ -99,7 +161,7 @@ impl<T: Weigh> Cache<T> {
                         key: key.clone(),
                         slot: slot.clone(),
                         bytes: 0,
-                        last_use: *clock,
+                        last_use: now,
                     });
                     slot
                 }
@@ -117,43 +179,65 @@ impl<T: Weigh> Cache<T> {
         Ok(map)
     }
 
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Entry<T>>> {
+        self.entries.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     fn account(&self, key: &Key, bytes: usize) {
-        let mut guard = self.entries.lock().unwrap_or_else(|e| e.into_inner());
-        let (entries, _) = &mut *guard;
-        if let Some(e) = entries.iter_mut().find(|e| e.key == *key) {
+        {
+            let mut entries = self.lock();
+            // Evicted while it was computed: it is not held, so not counted.
+            let Some(e) = entries.iter_mut().find(|e| e.key == *key) else {
+                return;
+            };
             e.bytes = bytes;
         }
-        // Evict least recently used entries (never the one just made) over budget.
-        while entries.iter().map(|e| e.bytes).sum::<usize>() > self.budget && entries.len() > 1 {
-            let Some((i, _)) = entries
+        USED.fetch_add(bytes, Ordering::AcqRel);
+        self.shrink(key);
+    }
+
+    /// Evicts the least recently used entries of the whole process (never
+    /// `keep`, the value just made) until the total fits the budget.
+    fn shrink(&self, keep: &Key) {
+        let caches = CACHES.lock().unwrap_or_else(|e| e.into_inner());
+        let me: *const Entries<T> = Arc::as_ptr(&self.entries);
+        while USED.load(Ordering::Acquire) > budget() {
+            let oldest = caches
                 .iter()
-                .enumerate()
-                .filter(|(_, e)| e.key != *key)
-                .min_by_key(|(_, e)| e.last_use)
-            else {
+                .filter_map(|w| w.upgrade())
+                .filter_map(|c| {
+                    let own = std::ptr::addr_eq(Arc::as_ptr(&c), me);
+                    let age = c.oldest(if own { Some(keep) } else { None })?;
+                    Some((age, c, own))
+                })
+                .min_by_key(|(age, _, _)| *age);
+            let Some((_, cache, own)) = oldest else { break };
+            let freed = cache.evict_oldest(if own { Some(keep) } else { None });
+            if freed == 0 {
                 break;
-            };
-            entries.swap_remove(i);
+            }
+            USED.fetch_sub(freed, Ordering::AcqRel);
         }
     }
 
     pub fn clear(&self) {
-        self.entries
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .0
-            .clear();
+        let freed: usize = self.lock().drain(..).map(|e| e.bytes).sum();
+        USED.fetch_sub(freed, Ordering::AcqRel);
     }
 
     #[cfg(test)]
     pub fn bytes(&self) -> usize {
-        self.entries
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .0
-            .iter()
-            .map(|e| e.bytes)
-            .sum()
+        self.lock().iter().map(|e| e.bytes).sum()
+    }
+}
+
+impl<T> Drop for Cache<T> {
+    /// Gives its bytes back; drained under the lock eviction takes, so an
+    /// entry is never counted off twice.
+    fn drop(&mut self) {
+        let mut entries = self.entries.0.lock().unwrap_or_else(|e| e.into_inner());
+        let freed: usize = entries.drain(..).map(|e| e.bytes).sum();
+        USED.fetch_sub(freed, Ordering::AcqRel);
     }
 }
 
@@ -208,14 +292,27 @@ mod tests {
         assert_eq!((a.window.width(), b.window.width()), (1, 2));
     }
 
+    /// Every cache of the process together stays within the one budget,
+    /// the oldest values going first, whichever cache holds them.
     #[test]
-    fn stays_within_its_budget() {
-        let cache = WarpCache::new(100 * 8);
-        for k in 0..10 {
-            cache
-                .get_or_compute::<()>(Key::of(&k), || Ok(map(40)))
+    fn all_caches_together_stay_within_the_process_budget() {
+        let map_bytes = map(1 << 20).bytes(); // 8 MiB
+        let per_budget = budget() / map_bytes;
+        let (first, second) = (WarpCache::default(), WarpCache::default());
+        first
+            .get_or_compute::<()>(Key::of(&"old"), || Ok(map(1 << 20)))
+            .unwrap();
+        for k in 0..per_budget + 3 {
+            second
+                .get_or_compute::<()>(Key::of(&k), || Ok(map(1 << 20)))
                 .unwrap();
         }
-        assert!(cache.bytes() <= 100 * 8);
+        assert!(first.bytes() + second.bytes() <= budget());
+        assert_eq!(
+            first.bytes(),
+            0,
+            "the oldest value, in the other cache, went first"
+        );
+        assert!(second.bytes() >= budget() - map_bytes);
     }
 }
