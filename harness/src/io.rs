@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use exr::prelude::*;
+use rayon::prelude::*;
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 
@@ -212,25 +213,34 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
     };
     let bounds = data_bounds(display, pos, (w, h));
     let mut image = Image::new(bounds, 4);
-    for (c, pick) in picks.iter().enumerate() {
-        match pick {
-            Some(k) => {
-                let samples = &list[*k].sample_data;
-                for row in 0..h {
-                    let j = h - 1 - row;
-                    for x in 0..w {
-                        image.data[(j * w + x) * 4 + c] =
-                            samples.value_by_flat_index(row * w + x).to_f32();
+    let sources: Vec<Option<&FlatSamples>> = picks
+        .iter()
+        .map(|pick| pick.map(|k| &list[k].sample_data))
+        .collect();
+    // Rows in parallel: the file's rows run top-down, ours bottom-up.
+    image
+        .data
+        .par_chunks_mut((w * 4).max(1))
+        .enumerate()
+        .for_each(|(j, out)| {
+            let first = (h - 1 - j) * w;
+            for (c, source) in sources.iter().enumerate() {
+                // This channel's sample of each pixel of the row.
+                let dst = out.iter_mut().skip(c).step_by(4);
+                match source {
+                    Some(FlatSamples::F16(v)) => {
+                        dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = s.to_f32())
                     }
+                    Some(FlatSamples::F32(v)) => {
+                        dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = *s)
+                    }
+                    Some(FlatSamples::U32(v)) => {
+                        dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = *s as f32)
+                    }
+                    None => dst.for_each(|d| *d = 1.0),
                 }
             }
-            None => {
-                for px in image.data.chunks_exact_mut(4) {
-                    px[c] = 1.0;
-                }
-            }
-        }
-    }
+        });
     Ok(Plate {
         image,
         size: (display.size.width(), display.size.height()),
@@ -390,7 +400,6 @@ fn write_exr(
     let (w, h) = (img.width(), img.height());
     let b = img.bounds;
     let dh = plate.size.1 as i32;
-    let pixel = |pos: Vec2<usize>| rgba_at(plate, pos.x(), pos.y());
     // Scan lines, as compositing packages write and read fastest.
     let encoding = Encoding {
         compression: format.compression,
@@ -403,23 +412,47 @@ fn write_exr(
     let (ox, oy) = plate.origin;
     let position = Vec2(ox + b.x1, oy + dh - b.y2);
     let display = IntegerBounds::new(Vec2(ox, oy), Vec2(plate.size.0, plate.size.1));
-    macro_rules! write_with {
-        ($conv:expr) => {{
-            let channels = SpecificChannels::rgba(move |pos: Vec2<usize>| {
-                let p = pixel(pos);
-                ($conv(p[0]), $conv(p[1]), $conv(p[2]), $conv(p[3]))
-            });
-            let mut layer = Layer::new(Vec2(w, h), LayerAttributes::default(), encoding, channels);
-            layer.attributes.layer_position = position;
-            let mut image = exr::prelude::Image::from_layer(layer);
-            image.attributes.display_window = display;
-            image.write().to_file(path).map_err(err)
-        }};
-    }
-    match format.precision {
-        ExrPrecision::Float => write_with!(|v: f32| v),
-        ExrPrecision::Half => write_with!(f16::from_f32),
-    }
+    let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = ["R", "G", "B", "A"]
+        .iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let samples = match format.precision {
+                ExrPrecision::Float => FlatSamples::F32(channel(plate, c, |v| v)),
+                ExrPrecision::Half => FlatSamples::F16(channel(plate, c, f16::from_f32)),
+            };
+            AnyChannel::new(*name, samples)
+        })
+        .collect();
+    let mut layer = Layer::new(
+        Vec2(w, h),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(channels),
+    );
+    layer.attributes.layer_position = position;
+    let mut image = exr::prelude::Image::from_layer(layer);
+    image.attributes.display_window = display;
+    image.write().to_file(path).map_err(err)
+}
+
+/// Channel `c` (R, G, B, A; A is 1 where the plate has none) of `plate` in
+/// the file's row order (top-down), converted by `convert`; rows in parallel.
+fn channel<T: Send + Default + Clone>(
+    plate: &Plate,
+    c: usize,
+    convert: impl Fn(f32) -> T + Sync,
+) -> Vec<T> {
+    let img = &plate.image;
+    let (w, h) = (img.width(), img.height());
+    let mut out = vec![T::default(); w * h];
+    out.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(row, dst)| {
+            for (x, d) in dst.iter_mut().enumerate() {
+                *d = convert(rgba_at(plate, x, row)[c]);
+            }
+        });
+    out
 }
 
 fn write_other(

@@ -238,6 +238,7 @@ enum Command {
 }
 
 fn main() {
+    morphfx_harness::host::allocator::tune_for_frames();
     let cli = Cli::parse();
     if cli.verbose {
         // The plugin is told through its environment (set before it is
@@ -527,8 +528,8 @@ impl Plates {
         let started = Instant::now();
         let plate = io::read_as(&path, self.colour)?;
         *self.read_time.lock().unwrap_or_else(|e| e.into_inner()) += started.elapsed();
-        let f = Arc::new(Frame::from_image(&plate.image, "OfxBitDepthFloat", false));
-        Ok((f, plate.size))
+        let size = plate.size;
+        Ok((Arc::new(Frame::from_float_image(plate.image)), size))
     }
 
     /// Starts reading `frame` on another thread, unless it is at hand.
@@ -569,11 +570,11 @@ impl Plates {
         Ok(loaded)
     }
 
-    /// Keeps `frame` at hand, with its neighbours (a render may ask for the
-    /// frames around it); farther frames go.
+    /// Keeps `frame` at hand, and the next (read ahead); the others go: a
+    /// sequence is rendered in order, each frame once.
     fn keep(&self, frame: i64, (f, size): &Loaded) {
         let mut cache = lock(&self.cache);
-        cache.retain(|(k, _, _)| (k - frame).abs() <= 2 && *k != frame);
+        cache.retain(|(k, _, _)| *k == frame + 1);
         cache.push((frame, f.clone(), *size));
     }
 }
@@ -661,6 +662,19 @@ struct Prepared {
     inputs: Inputs,
 }
 
+impl Prepared {
+    /// Whether features or progress change over the frames (keyframes,
+    /// keyed line slots, progress keys not overridden by a fixed `--t`).
+    fn animated(&self, fixed_t: bool) -> bool {
+        let keyed_lines = self.lines.iter().filter(|l| l.frame.is_some()).count() > 1;
+        let scene = self.scene.as_ref().is_some_and(|s| {
+            let progress = !fixed_t && s.progress.windows(2).any(|w| w[0].1 != w[1].1);
+            s.keyframes.len() > 1 || s.meshes.len() > 1 || progress
+        });
+        keyed_lines || scene
+    }
+}
+
 struct Job {
     plugin: &'static str,
     context: &'static str,
@@ -677,8 +691,7 @@ impl Job {
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;
         self.set_up(&inst, &job.lines, &job.plates, job.inputs.size)?;
-        let scene = job.scene.as_ref();
-        self.render_frames(&inst, &job.frames, &job.plates, scene, &job.inputs)
+        self.render_frames(&inst, &job)
     }
 
     /// `morphfx overlay`: the plugin's overlay drawn over the plates.
@@ -814,15 +827,15 @@ impl Job {
 
     /// Renders every frame of every output as one sequence, and says where
     /// the time went.
-    fn render_frames(
-        &self,
-        inst: &Instance<'_>,
-        frames: &[i64],
-        plates: &[(String, Arc<Plates>)],
-        scene: Option<&Scene>,
-        inputs: &Inputs,
-    ) -> Result<(), HostError> {
+    fn render_frames(&self, inst: &Instance<'_>, job: &Prepared) -> Result<(), HostError> {
+        let (frames, plates, inputs) = (&job.frames, &job.plates, &job.inputs);
+        let scene = job.scene.as_ref();
         let c = &self.common;
+        let transition = self.context == "OfxImageEffectContextTransition";
+        // A frame's warps serve it alone when what they are made from moves
+        // from frame to frame: the plugin's caches are purged after each,
+        // so memory stays flat however long the shot.
+        let purge = transition || job.animated(c.t.is_some());
         // Half in, half out, and the input's compression, unless the user
         // says otherwise.
         let format = c.output_format(inputs)?;
@@ -844,8 +857,7 @@ impl Job {
         };
         let mut rendering = Duration::ZERO;
         // Frame n is written while frame n + 1 renders.
-        let writer = WriteBehind::new(2);
-        let transition = self.context == "OfxImageEffectContextTransition";
+        let writer = WriteBehind::new(0);
         for (n, &f) in frames.iter().enumerate() {
             if transition {
                 // The host drives the context's mandated Transition param, as
@@ -874,11 +886,14 @@ impl Job {
                 let out = inst.render(f as f64, spec).map_err(read_error)?;
                 rendering += started.elapsed();
                 let plate = Plate {
-                    image: out.to_image(),
+                    image: out.into_image(),
                     size: inputs.size,
                     origin: inputs.windows.get(&f).map_or((0, 0), |w| w.origin),
                 };
                 writer.write(frame_path(pattern, f), plate, format)?;
+            }
+            if purge {
+                inst.purge_caches()?;
             }
             progress.tick(n + 1, f);
         }

@@ -65,8 +65,71 @@ impl Frame {
         }
     }
 
+    /// A float, bottom-up frame holding `img`'s pixels (moved, not copied:
+    /// a sequence render hands over a plate a frame).
+    pub fn from_float_image(img: Image) -> Frame {
+        Frame {
+            bounds: img.bounds,
+            channels: img.channels,
+            pixels: std::cell::UnsafeCell::new(Pixels::F32(img.data)),
+            top_down: false,
+            premultiplied: true,
+            par: 1.0,
+        }
+    }
+
+    /// The frame as float pixels, bottom-up; moved out when this is the
+    /// last reference to a float, bottom-up frame, copied otherwise.
+    pub fn into_image(self: Arc<Self>) -> Image {
+        match Arc::try_unwrap(self) {
+            Ok(f) if !f.top_down => {
+                let Frame {
+                    bounds,
+                    channels,
+                    pixels,
+                    top_down,
+                    premultiplied,
+                    par,
+                } = f;
+                match pixels.into_inner() {
+                    Pixels::F32(data) => Image {
+                        bounds,
+                        channels,
+                        data,
+                    },
+                    other => Frame {
+                        bounds,
+                        channels,
+                        pixels: std::cell::UnsafeCell::new(other),
+                        top_down,
+                        premultiplied,
+                        par,
+                    }
+                    .to_image(),
+                }
+            }
+            Ok(f) => f.to_image(),
+            Err(shared) => shared.to_image(),
+        }
+    }
+
+    /// A zeroed frame, allocated zeroed (no image made and converted: a
+    /// render's output buffer is 33 MB at 1080p).
     pub fn blank(bounds: RectI, channels: usize, depth: &str, top_down: bool) -> Frame {
-        Frame::from_image(&Image::new(bounds, channels), depth, top_down)
+        let n = bounds.area() * channels;
+        let pixels = match depth {
+            "OfxBitDepthByte" => Pixels::U8(vec![0; n]),
+            "OfxBitDepthShort" => Pixels::U16(vec![0; n]),
+            _ => Pixels::F32(vec![0.0; n]),
+        };
+        Frame {
+            bounds,
+            channels,
+            pixels: std::cell::UnsafeCell::new(pixels),
+            top_down,
+            premultiplied: true,
+            par: 1.0,
+        }
     }
 
     pub fn depth(&self) -> &'static str {

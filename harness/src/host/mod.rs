@@ -2,6 +2,7 @@
 //! action sequence a real host follows. All `unsafe` of the harness lives in
 //! this module, each block with its safety argument.
 
+pub mod allocator;
 pub mod effect;
 pub mod frame;
 pub mod overlay;
@@ -612,6 +613,11 @@ impl Instance<'_> {
             None => p.set(v),
         }
         Ok(())
+    }
+
+    /// Tells the plugin to drop what it caches (`kOfxActionPurgeCaches`).
+    pub fn purge_caches(&self) -> Result<(), HostError> {
+        self.act(kOfxActionPurgeCaches, None, None).map(|_| ())
     }
 
     /// The messages the plugin posted since the last call (message suite).

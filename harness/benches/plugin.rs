@@ -1,0 +1,144 @@
+//! A render through the plugin against the core doing the same work, in
+//! the same run: 1080p RGBA float, 100 line pairs, t = 0.5, the field
+//! method. The plugin's path adds the host's images, the param reads, the
+//! cache and the copies; this says what they cost.
+//!
+//! `cargo xtask bundle --release && cargo bench -p morphfx-harness --bench plugin`
+
+use std::hint::black_box;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+
+use morphfx::features::{Feature, Side};
+use morphfx::geom::{PixelScale, RectI, Vec2};
+use morphfx::image::{EdgeMode, Filter, Image, Sampler};
+use morphfx::make_warp::{toward, MethodSettings, WarpSettings};
+use morphfx::morph::{dissolve, Warped};
+use morphfx::testing::Lcg;
+use morphfx_harness::host::{Bundle, Frame, FrameSource, OutputSpec};
+
+const W: usize = 1920;
+const H: usize = 1080;
+
+fn plate(seed: f32) -> Image {
+    Image::from_fn(RectI::from_size(W, H), 4, |i, j, c| {
+        if c == 3 {
+            1.0
+        } else {
+            let (x, y) = (i as f32, j as f32);
+            0.5 + 0.5 * ((x * 0.05 + seed) * (c as f32 + 1.0)).sin() * (y * 0.031).cos()
+        }
+    })
+}
+
+/// 100 line pairs spread over the frame, each moved and turned a little.
+fn lines() -> Vec<Feature> {
+    let mut r = Lcg::new(100);
+    (0..100)
+        .map(|_| {
+            let p = Vec2::new(
+                r.range(100.0, W as f64 - 100.0),
+                r.range(100.0, H as f64 - 100.0),
+            );
+            let (len, angle) = (r.range(40.0, 300.0), r.range(0.0, 6.28));
+            let q = p + Vec2::new(angle.cos(), angle.sin()) * len;
+            let d = Vec2::new(r.range(-20.0, 20.0), r.range(-20.0, 20.0));
+            Feature::line([p, q], [p + d, q + d * 0.8])
+        })
+        .collect()
+}
+
+struct Still(Arc<Frame>);
+
+impl FrameSource for Still {
+    fn frame(&self, _: f64) -> Result<Arc<Frame>, String> {
+        Ok(self.0.clone())
+    }
+}
+
+fn scene_json(features: &[Feature]) -> String {
+    let pts = |v: &[Vec2]| v.iter().map(|p| vec![p.x, p.y]).collect::<Vec<_>>();
+    let list: Vec<serde_json::Value> = features
+        .iter()
+        .map(|f| {
+            serde_json::json!({"type": "line", "a": pts(f.points(Side::A)), "b": pts(f.points(Side::B))})
+        })
+        .collect();
+    serde_json::json!({"format": "morphfx-scene", "version": 1, "method": "field", "features": list})
+        .to_string()
+}
+
+fn bundle_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bundle/MorphFX.ofx.bundle")
+}
+
+fn bench_plugin_path(c: &mut Criterion) {
+    let (a, b) = (plate(0.0), plate(1.3));
+    let features = lines();
+    let mut g = c.benchmark_group("render_1080p_100_lines_t0.5");
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+
+    // The core: both maps made afresh, then the dissolve.
+    let settings = WarpSettings::new(MethodSettings::default());
+    let frame = RectI::from_size(W, H);
+    let mut out = Image::new(frame, 4);
+    g.bench_function("core_maps_and_dissolve", |bch| {
+        bch.iter(|| {
+            let wa = toward(&features, Side::A, 0.5, &settings).unwrap();
+            let wb = toward(&features, Side::B, 0.5, &settings).unwrap();
+            let ma = wa.map_window(frame, PixelScale::UNIT);
+            let mb = wb.map_window(frame, PixelScale::UNIT);
+            let sa = Sampler::new(
+                a.view(),
+                PixelScale::UNIT,
+                Filter::Bilinear,
+                EdgeMode::Clamp,
+                true,
+            );
+            let sb = Sampler::new(
+                b.view(),
+                PixelScale::UNIT,
+                Filter::Bilinear,
+                EdgeMode::Clamp,
+                true,
+            );
+            dissolve(
+                Warped::Map(&sa, &ma),
+                Warped::Map(&sb, &mb),
+                0.5,
+                out.view_mut().rows(),
+            );
+            black_box(&out);
+        })
+    });
+
+    // The plugin: the same scene through the C ABI; caches purged before
+    // each render, so the maps are made afresh, as for a keyframed shot.
+    let bundle = Bundle::load(&bundle_path()).expect("the bundle (cargo xtask bundle --release)");
+    let inst = bundle
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    for (clip, img) in [("SourceA", &a), ("SourceB", &b)] {
+        let f = Arc::new(Frame::from_image(img, "OfxBitDepthFloat", false));
+        inst.connect(clip, Arc::new(Still(f))).unwrap();
+    }
+    inst.set_project(W as f64, H as f64);
+    inst.set_string("scene_text", &scene_json(&features))
+        .unwrap();
+    inst.set_double("progress", &[0.5], None).unwrap();
+    inst.set_int("use_scene_progress", 0).unwrap();
+    inst.clip_preferences().unwrap();
+    g.bench_function("plugin_render", |bch| {
+        bch.iter(|| {
+            inst.purge_caches().unwrap();
+            black_box(inst.render(1.0, OutputSpec::default()).unwrap())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_plugin_path);
+criterion_main!(benches);
