@@ -43,7 +43,7 @@ fn lines() -> Vec<Feature> {
                 r.range(100.0, W as f64 - 100.0),
                 r.range(100.0, H as f64 - 100.0),
             );
-            let (len, angle) = (r.range(40.0, 300.0), r.range(0.0, 6.28));
+            let (len, angle) = (r.range(40.0, 300.0), r.range(0.0, std::f64::consts::TAU));
             let q = p + Vec2::new(angle.cos(), angle.sin()) * len;
             let d = Vec2::new(r.range(-20.0, 20.0), r.range(-20.0, 20.0));
             Feature::line([p, q], [p + d, q + d * 0.8])

@@ -8,9 +8,9 @@
 use std::path::Path;
 
 use exr::prelude::*;
-use rayon::prelude::*;
 use morphfx::geom::RectI;
 use morphfx::image::Image;
+use rayon::prelude::*;
 
 use crate::host::HostError;
 
@@ -228,15 +228,15 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
                 // This channel's sample of each pixel of the row.
                 let dst = out.iter_mut().skip(c).step_by(4);
                 match source {
-                    Some(FlatSamples::F16(v)) => {
-                        dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = s.to_f32())
-                    }
+                    Some(FlatSamples::F16(v)) => dst
+                        .zip(&v[first..first + w])
+                        .for_each(|(d, s)| *d = s.to_f32()),
                     Some(FlatSamples::F32(v)) => {
                         dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = *s)
                     }
-                    Some(FlatSamples::U32(v)) => {
-                        dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = *s as f32)
-                    }
+                    Some(FlatSamples::U32(v)) => dst
+                        .zip(&v[first..first + w])
+                        .for_each(|(d, s)| *d = *s as f32),
                     None => dst.for_each(|d| *d = 1.0),
                 }
             }
@@ -396,6 +396,11 @@ fn write_exr(
     plate: &Plate,
     format: OutputFormat,
 ) -> std::result::Result<(), HostError> {
+    match format.compression {
+        Compression::ZIP16 => return crate::exr_zip::write(path, plate, format.precision, 16),
+        Compression::ZIP1 => return crate::exr_zip::write(path, plate, format.precision, 1),
+        _ => {}
+    }
     let img = &plate.image;
     let (w, h) = (img.width(), img.height());
     let b = img.bounds;
