@@ -599,7 +599,8 @@ struct LineKey {
 }
 
 impl LineKey {
-    const SLOTS: usize = 16;
+    /// The nodes' line slots (Line Count at most).
+    const SLOTS: usize = 64;
 
     fn parse(spec: &str) -> Result<LineKey, HostError> {
         let bad = |why: &str| {

@@ -193,28 +193,32 @@ unsafe extern "C" fn get_property_set(
     h: OfxImageEffectHandle,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    let Some(e) = live_effect(h as *const c_void) else {
-        return kOfxStatErrBadHandle;
-    };
-    if !props.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *props = e.props.handle() };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "get_property_set", || {
+        let Some(e) = live_effect(h as *const c_void) else {
+            return kOfxStatErrBadHandle;
+        };
+        if !props.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *props = e.props.handle() };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn get_param_set(
     h: OfxImageEffectHandle,
     set: *mut OfxParamSetHandle,
 ) -> OfxStatus {
-    let Some(e) = live_effect(h as *const c_void) else {
-        return kOfxStatErrBadHandle;
-    };
-    if !set.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *set = &e.params as *const ParamSet as OfxParamSetHandle };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "get_param_set", || {
+        let Some(e) = live_effect(h as *const c_void) else {
+            return kOfxStatErrBadHandle;
+        };
+        if !set.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *set = &e.params as *const ParamSet as OfxParamSetHandle };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn clip_define(
@@ -222,25 +226,27 @@ unsafe extern "C" fn clip_define(
     name: *const c_char,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    let Some(e) = live_effect(h as *const c_void) else {
-        return kOfxStatErrBadHandle;
-    };
-    if name.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: NUL-terminated name from the plugin.
-    let name = unsafe { CStr::from_ptr(name) }
-        .to_string_lossy()
-        .into_owned();
-    let clip = match e.clip(&name) {
-        Some(c) => c,
-        None => e.add_clip(&name, PropertySet::new()),
-    };
-    if !props.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *props = clip.props.handle() };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "clip_define", || {
+        let Some(e) = live_effect(h as *const c_void) else {
+            return kOfxStatErrBadHandle;
+        };
+        if name.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: NUL-terminated name from the plugin.
+        let name = unsafe { CStr::from_ptr(name) }
+            .to_string_lossy()
+            .into_owned();
+        let clip = match e.clip(&name) {
+            Some(c) => c,
+            None => e.add_clip(&name, PropertySet::new()),
+        };
+        if !props.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *props = clip.props.handle() };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn clip_get_handle(
@@ -249,42 +255,46 @@ unsafe extern "C" fn clip_get_handle(
     clip: *mut OfxImageClipHandle,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    let Some(e) = live_effect(h as *const c_void) else {
-        return kOfxStatErrBadHandle;
-    };
-    if name.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: NUL-terminated name from the plugin.
-    let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
-    let Some(c) = e.clip(&name) else {
-        return kOfxStatErrUnknown;
-    };
-    // SAFETY: each out-pointer is written only when non-null; both are the plugin's variables.
-    unsafe {
-        if !clip.is_null() {
-            *clip = c as *const Clip as OfxImageClipHandle;
+    super::guard::guard(kOfxStatErrUnknown, "clip_get_handle", || {
+        let Some(e) = live_effect(h as *const c_void) else {
+            return kOfxStatErrBadHandle;
+        };
+        if name.is_null() {
+            return kOfxStatErrBadHandle;
         }
-        if !props.is_null() {
-            *props = c.props.handle();
+        // SAFETY: NUL-terminated name from the plugin.
+        let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
+        let Some(c) = e.clip(&name) else {
+            return kOfxStatErrUnknown;
+        };
+        // SAFETY: each out-pointer is written only when non-null; both are the plugin's variables.
+        unsafe {
+            if !clip.is_null() {
+                *clip = c as *const Clip as OfxImageClipHandle;
+            }
+            if !props.is_null() {
+                *props = c.props.handle();
+            }
         }
-    }
-    kOfxStatOK
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn clip_get_property_set(
     clip: OfxImageClipHandle,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
-    let Some(c) = (unsafe { clip_of(clip) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if !props.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *props = c.props.handle() };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "clip_get_property_set", || {
+        // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
+        let Some(c) = (unsafe { clip_of(clip) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if !props.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *props = c.props.handle() };
+        }
+        kOfxStatOK
+    })
 }
 
 impl Clip {
@@ -358,67 +368,71 @@ unsafe extern "C" fn clip_get_image(
     _region: *const OfxRectD,
     image: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
-    let Some(c) = (unsafe { clip_of(clip) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if image.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    let frame = match c.frame_at(time) {
-        Ok(Some(f)) => f,
-        Ok(None) => return kOfxStatFailed,
-        Err(message) => {
-            c.effect()
-                .messages
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .push(Message {
-                    kind: "OfxMessageError".into(),
-                    id: "net.morphfx.harness.MissingFrame".into(),
-                    text: message,
-                });
-            return kOfxStatFailed;
+    super::guard::guard(kOfxStatErrUnknown, "clip_get_image", || {
+        // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
+        let Some(c) = (unsafe { clip_of(clip) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if image.is_null() {
+            return kOfxStatErrBadHandle;
         }
-    };
-    let scale = *c
-        .effect()
-        .render_scale
-        .lock()
-        .unwrap_or_else(|e| e.into_inner());
-    let props = frame.image_props(scale, time);
-    // SAFETY: out-pointer from the plugin. The boxed set (owning the frame) is
-    // released by clipReleaseImage.
-    unsafe { *image = Box::into_raw(Box::new(props)) as OfxPropertySetHandle };
-    kOfxStatOK
+        let frame = match c.frame_at(time) {
+            Ok(Some(f)) => f,
+            Ok(None) => return kOfxStatFailed,
+            Err(message) => {
+                c.effect()
+                    .messages
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(Message {
+                        kind: "OfxMessageError".into(),
+                        id: "net.morphfx.harness.MissingFrame".into(),
+                        text: message,
+                    });
+                return kOfxStatFailed;
+            }
+        };
+        let scale = *c
+            .effect()
+            .render_scale
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let props = frame.image_props(scale, time);
+        // SAFETY: out-pointer from the plugin. The boxed set (owning the frame) is
+        // released by clipReleaseImage.
+        unsafe { *image = Box::into_raw(Box::new(props)) as OfxPropertySetHandle };
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn clip_release_image(image: OfxPropertySetHandle) -> OfxStatus {
-    if image.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: image handles come only from Box::into_raw in clip_get_image
-    // and are never freed (see below), so the set is live.
-    let set = unsafe { &*(image as *const PropertySet) };
-    if set.released.swap(true, Ordering::Relaxed) {
-        super::violation("an image released twice".into());
-        return kOfxStatErrBadHandle;
-    }
-    // The pixels go now; the emptied set stays, so a later use is reported
-    // (by the property suite) instead of reading freed memory.
-    // SAFETY: as above; the plugin gave up the handle with this call, and
-    // only this function (once per image, checked above) takes the box back.
-    let mut set = unsafe { Box::from_raw(image as *mut PropertySet) };
-    set.owner = None;
-    set.clear();
-    let mut released = RELEASED.lock().unwrap_or_else(|e| e.into_inner());
-    if released.len() == RELEASED_KEPT {
-        // A long render stays flat in memory: the oldest shells go (a
-        // plugin misusing an image does so within a frame or two).
-        released.pop_front();
-    }
-    released.push_back(SendSet(set));
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "clip_release_image", || {
+        if image.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: image handles come only from Box::into_raw in clip_get_image
+        // and are never freed (see below), so the set is live.
+        let set = unsafe { &*(image as *const PropertySet) };
+        if set.released.swap(true, Ordering::Relaxed) {
+            super::violation("an image released twice".into());
+            return kOfxStatErrBadHandle;
+        }
+        // The pixels go now; the emptied set stays, so a later use is reported
+        // (by the property suite) instead of reading freed memory.
+        // SAFETY: as above; the plugin gave up the handle with this call, and
+        // only this function (once per image, checked above) takes the box back.
+        let mut set = unsafe { Box::from_raw(image as *mut PropertySet) };
+        set.owner = None;
+        set.clear();
+        let mut released = RELEASED.lock().unwrap_or_else(|e| e.into_inner());
+        if released.len() == RELEASED_KEPT {
+            // A long render stays flat in memory: the oldest shells go (a
+            // plugin misusing an image does so within a frame or two).
+            released.pop_front();
+        }
+        released.push_back(SendSet(set));
+        kOfxStatOK
+    })
 }
 
 /// Released images' emptied property sets (a few dozen bytes each), the
@@ -434,29 +448,31 @@ unsafe extern "C" fn clip_get_rod(
     time: OfxTime,
     bounds: *mut OfxRectD,
 ) -> OfxStatus {
-    // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
-    let Some(c) = (unsafe { clip_of(clip) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    let Some(r) = c.rod(time) else {
-        return kOfxStatFailed;
-    };
-    if !bounds.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe {
-            *bounds = OfxRectD {
-                x1: r.x1 as f64,
-                y1: r.y1 as f64,
-                x2: r.x2 as f64,
-                y2: r.y2 as f64,
-            };
+    super::guard::guard(kOfxStatErrUnknown, "clip_get_rod", || {
+        // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
+        let Some(c) = (unsafe { clip_of(clip) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        let Some(r) = c.rod(time) else {
+            return kOfxStatFailed;
+        };
+        if !bounds.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe {
+                *bounds = OfxRectD {
+                    x1: r.x1 as f64,
+                    y1: r.y1 as f64,
+                    x2: r.x2 as f64,
+                    y2: r.y2 as f64,
+                };
+            }
         }
-    }
-    kOfxStatOK
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn abort(_: OfxImageEffectHandle) -> c_int {
-    0
+    super::guard::guard(0, "abort", || 0)
 }
 
 unsafe extern "C" fn memory_alloc(
@@ -464,16 +480,20 @@ unsafe extern "C" fn memory_alloc(
     _: usize,
     _: *mut OfxImageMemoryHandle,
 ) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "memory_alloc", || {
+        kOfxStatErrUnsupported
+    })
 }
 unsafe extern "C" fn memory_free(_: OfxImageMemoryHandle) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "memory_free", || kOfxStatErrUnsupported)
 }
 unsafe extern "C" fn memory_lock(_: OfxImageMemoryHandle, _: *mut *mut c_void) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "memory_lock", || kOfxStatErrUnsupported)
 }
 unsafe extern "C" fn memory_unlock(_: OfxImageMemoryHandle) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "memory_unlock", || {
+        kOfxStatErrUnsupported
+    })
 }
 
 pub static SUITE: OfxImageEffectSuiteV1 = OfxImageEffectSuiteV1 {
@@ -522,13 +542,15 @@ pub unsafe extern "C" fn mfx_message_text(
     id: *const c_char,
     text: *const c_char,
 ) -> c_int {
-    // SAFETY: the shim passes C strings or nulls.
-    let m = unsafe { message_of(kind, id, text) };
-    match live_effect(handle) {
-        Some(e) => e.messages.lock().unwrap_or_else(|e| e.into_inner()).push(m),
-        None => eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text),
-    }
-    kOfxStatOK
+    super::guard::guard(0, "mfx_message_text", || {
+        // SAFETY: the shim passes C strings or nulls.
+        let m = unsafe { message_of(kind, id, text) };
+        match live_effect(handle) {
+            Some(e) => e.messages.lock().unwrap_or_else(|e| e.into_inner()).push(m),
+            None => eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text),
+        }
+        kOfxStatOK
+    })
 }
 
 /// # Safety
@@ -540,22 +562,26 @@ pub unsafe extern "C" fn mfx_persistent_text(
     id: *const c_char,
     text: *const c_char,
 ) -> c_int {
-    // The spec: the handle may NOT be null, and must be an instance.
-    let Some(e) = live_effect(handle) else {
-        return kOfxStatErrBadHandle;
-    };
-    // SAFETY: the shim passes C strings or nulls.
-    let m = unsafe { message_of(kind, id, text) };
-    *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = Some(m);
-    kOfxStatOK
+    super::guard::guard(0, "mfx_persistent_text", || {
+        // The spec: the handle may NOT be null, and must be an instance.
+        let Some(e) = live_effect(handle) else {
+            return kOfxStatErrBadHandle;
+        };
+        // SAFETY: the shim passes C strings or nulls.
+        let m = unsafe { message_of(kind, id, text) };
+        *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = Some(m);
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn clear_persistent(handle: *mut c_void) -> OfxStatus {
-    let Some(e) = live_effect(handle) else {
-        return kOfxStatErrBadHandle;
-    };
-    *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = None;
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "clear_persistent", || {
+        let Some(e) = live_effect(handle) else {
+            return kOfxStatErrBadHandle;
+        };
+        *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" {

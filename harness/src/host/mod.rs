@@ -5,6 +5,7 @@
 pub mod allocator;
 pub mod effect;
 pub mod frame;
+pub mod guard;
 pub mod overlay;
 pub mod params;
 pub mod props;
@@ -103,6 +104,16 @@ pub fn violation(what: String) {
         .push(what);
 }
 
+/// Records a failure of this host itself (a callback that panicked): kept
+/// with the violations, so tests fail on it, but not blamed on the plugin.
+pub fn host_failure(what: String) {
+    eprintln!("morphfx: host failure: {what}");
+    VIOLATIONS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(what);
+}
+
 /// Held by unit tests that read [`take_violations`], which is process-wide.
 #[cfg(test)]
 pub(crate) static VIOLATION_TESTS: Mutex<()> = Mutex::new(());
@@ -117,52 +128,58 @@ unsafe extern "C" fn fetch_suite(
     name: *const c_char,
     version: c_int,
 ) -> *const c_void {
-    if name.is_null() {
-        return std::ptr::null();
-    }
-    // SAFETY: suite names are NUL-terminated C strings.
-    let name = unsafe { CStr::from_ptr(name) };
-    let loaded = LOADED_HOSTS
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .contains(&(host as usize));
-    if !loaded {
-        violation(format!(
-            "fetchSuite({}, {version}) before the load action",
-            name.to_string_lossy()
-        ));
-        return std::ptr::null();
-    }
-    match (name, version) {
-        (n, 1) if n == kOfxPropertySuite => &props::SUITE as *const _ as *const c_void,
-        (n, 1) if n == kOfxImageEffectSuite => &effect::SUITE as *const _ as *const c_void,
-        (n, 1) if n == kOfxParameterSuite => &params::SUITE as *const _ as *const c_void,
-        (n, 1) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE as *const _ as *const c_void,
-        (n, 2) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE_V2 as *const _ as *const c_void,
-        (n, 1) if n == kOfxMemorySuite => &services::MEMORY_SUITE as *const _ as *const c_void,
-        (n, 1) if n == kOfxMultiThreadSuite => {
-            &services::MULTI_THREAD_SUITE as *const _ as *const c_void
+    guard::guard(std::ptr::null(), "fetch_suite", || {
+        if name.is_null() {
+            return std::ptr::null();
         }
-        (n, 1) if n == kOfxProgressSuite => {
-            &services::PROGRESS_SUITE_V1 as *const _ as *const c_void
+        // SAFETY: suite names are NUL-terminated C strings.
+        let name = unsafe { CStr::from_ptr(name) };
+        let loaded = LOADED_HOSTS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .contains(&(host as usize));
+        if !loaded {
+            violation(format!(
+                "fetchSuite({}, {version}) before the load action",
+                name.to_string_lossy()
+            ));
+            return std::ptr::null();
         }
-        (n, 2) if n == kOfxProgressSuite => {
-            &services::PROGRESS_SUITE_V2 as *const _ as *const c_void
+        match (name, version) {
+            (n, 1) if n == kOfxPropertySuite => &props::SUITE as *const _ as *const c_void,
+            (n, 1) if n == kOfxImageEffectSuite => &effect::SUITE as *const _ as *const c_void,
+            (n, 1) if n == kOfxParameterSuite => &params::SUITE as *const _ as *const c_void,
+            (n, 1) if n == kOfxMessageSuite => &effect::MESSAGE_SUITE as *const _ as *const c_void,
+            (n, 2) if n == kOfxMessageSuite => {
+                &effect::MESSAGE_SUITE_V2 as *const _ as *const c_void
+            }
+            (n, 1) if n == kOfxMemorySuite => &services::MEMORY_SUITE as *const _ as *const c_void,
+            (n, 1) if n == kOfxMultiThreadSuite => {
+                &services::MULTI_THREAD_SUITE as *const _ as *const c_void
+            }
+            (n, 1) if n == kOfxProgressSuite => {
+                &services::PROGRESS_SUITE_V1 as *const _ as *const c_void
+            }
+            (n, 2) if n == kOfxProgressSuite => {
+                &services::PROGRESS_SUITE_V2 as *const _ as *const c_void
+            }
+            (n, 1) if n == kOfxTimeLineSuite => {
+                &services::TIME_LINE_SUITE as *const _ as *const c_void
+            }
+            (n, 1)
+                if n == overlay::kOfxInteractSuite
+                    && offers(host, kOfxImageEffectPropSupportsOverlays) =>
+            {
+                &overlay::INTERACT_SUITE as *const _ as *const c_void
+            }
+            (n, 1) if n == overlay::kOfxDrawSuite && offers(host, overlay::DRAW_SUITE_PROP) => {
+                &overlay::DRAW_SUITE as *const _ as *const c_void
+            }
+            // Anything else (OpenGL render, dialogs, ...) this host does not provide: a
+            // null answer is how OFX says so.
+            _ => std::ptr::null(),
         }
-        (n, 1) if n == kOfxTimeLineSuite => &services::TIME_LINE_SUITE as *const _ as *const c_void,
-        (n, 1)
-            if n == overlay::kOfxInteractSuite
-                && offers(host, kOfxImageEffectPropSupportsOverlays) =>
-        {
-            &overlay::INTERACT_SUITE as *const _ as *const c_void
-        }
-        (n, 1) if n == overlay::kOfxDrawSuite && offers(host, overlay::DRAW_SUITE_PROP) => {
-            &overlay::DRAW_SUITE as *const _ as *const c_void
-        }
-        // Anything else (OpenGL render, dialogs, ...) this host does not provide: a
-        // null answer is how OFX says so.
-        _ => std::ptr::null(),
-    }
+    })
 }
 
 pub struct PluginInfo {

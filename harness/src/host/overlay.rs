@@ -92,47 +92,55 @@ unsafe extern "C" fn get_colour(
     _which: OfxStandardColour,
     colour: *mut OfxRGBAColourF,
 ) -> OfxStatus {
-    // SAFETY: our own handle, checked.
-    if unsafe { context(h, "getColour") }.is_none() || colour.is_null() {
-        return kOfxStatFailed;
-    }
-    // SAFETY: non-null out-pointer from the plugin.
-    unsafe {
-        *colour = OfxRGBAColourF {
-            r: 1.0,
-            g: 1.0,
-            b: 1.0,
-            a: 1.0,
+    super::guard::guard(kOfxStatErrUnknown, "get_colour", || {
+        // SAFETY: our own handle, checked.
+        if unsafe { context(h, "getColour") }.is_none() || colour.is_null() {
+            return kOfxStatFailed;
         }
-    };
-    kOfxStatOK
+        // SAFETY: non-null out-pointer from the plugin.
+        unsafe {
+            *colour = OfxRGBAColourF {
+                r: 1.0,
+                g: 1.0,
+                b: 1.0,
+                a: 1.0,
+            }
+        };
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn set_colour(h: OfxDrawContextHandle, c: *const OfxRGBAColourF) -> OfxStatus {
-    // SAFETY: the plugin's colour, checked non-null.
-    let Some(c) = (unsafe { c.as_ref() }) else {
-        return kOfxStatErrValue;
-    };
-    record(h, "setColour", DrawCall::Colour([c.r, c.g, c.b, c.a]))
+    super::guard::guard(kOfxStatErrUnknown, "set_colour", || {
+        // SAFETY: the plugin's colour, checked non-null.
+        let Some(c) = (unsafe { c.as_ref() }) else {
+            return kOfxStatErrValue;
+        };
+        record(h, "setColour", DrawCall::Colour([c.r, c.g, c.b, c.a]))
+    })
 }
 
 unsafe extern "C" fn set_width(h: OfxDrawContextHandle, w: f32) -> OfxStatus {
-    if !(w >= 0.0 && w.is_finite()) {
-        violation(format!("setLineWidth({w})"));
-        return kOfxStatErrValue;
-    }
-    record(h, "setLineWidth", DrawCall::Width(w))
+    super::guard::guard(kOfxStatErrUnknown, "set_width", || {
+        if !(w >= 0.0 && w.is_finite()) {
+            violation(format!("setLineWidth({w})"));
+            return kOfxStatErrValue;
+        }
+        record(h, "setLineWidth", DrawCall::Width(w))
+    })
 }
 
 unsafe extern "C" fn set_stipple(
     h: OfxDrawContextHandle,
     p: OfxDrawLineStipplePattern,
 ) -> OfxStatus {
-    if p > kOfxDrawLineStipplePatternDotDash {
-        violation(format!("setLineStipple({p}): no such pattern"));
-        return kOfxStatErrValue;
-    }
-    record(h, "setLineStipple", DrawCall::Stipple(p))
+    super::guard::guard(kOfxStatErrUnknown, "set_stipple", || {
+        if p > kOfxDrawLineStipplePatternDotDash {
+            violation(format!("setLineStipple({p}): no such pattern"));
+            return kOfxStatErrValue;
+        }
+        record(h, "setLineStipple", DrawCall::Stipple(p))
+    })
 }
 
 /// Whether `n` points make a `primitive` (the OpenGL rules the suite names).
@@ -154,19 +162,21 @@ unsafe extern "C" fn draw(
     points: *const OfxPointD,
     count: c_int,
 ) -> OfxStatus {
-    let n = usize::try_from(count).unwrap_or(0);
-    if points.is_null() || !valid_count(primitive, n) {
-        violation(format!("draw(primitive {primitive}, {count} points)"));
-        return kOfxStatErrValue;
-    }
-    // SAFETY: the plugin passes `count` points (checked non-null).
-    let pts = unsafe { std::slice::from_raw_parts(points, n) };
-    if pts.iter().any(|p| !(p.x.is_finite() && p.y.is_finite())) {
-        violation("draw with a non-finite point".into());
-        return kOfxStatErrValue;
-    }
-    let points = pts.iter().map(|p| [p.x, p.y]).collect();
-    record(h, "draw", DrawCall::Draw { primitive, points })
+    super::guard::guard(kOfxStatErrUnknown, "draw", || {
+        let n = usize::try_from(count).unwrap_or(0);
+        if points.is_null() || !valid_count(primitive, n) {
+            violation(format!("draw(primitive {primitive}, {count} points)"));
+            return kOfxStatErrValue;
+        }
+        // SAFETY: the plugin passes `count` points (checked non-null).
+        let pts = unsafe { std::slice::from_raw_parts(points, n) };
+        if pts.iter().any(|p| !(p.x.is_finite() && p.y.is_finite())) {
+            violation("draw with a non-finite point".into());
+            return kOfxStatErrValue;
+        }
+        let points = pts.iter().map(|p| [p.x, p.y]).collect();
+        record(h, "draw", DrawCall::Draw { primitive, points })
+    })
 }
 
 unsafe extern "C" fn draw_text(
@@ -175,17 +185,19 @@ unsafe extern "C" fn draw_text(
     pos: *const OfxPointD,
     align: c_int,
 ) -> OfxStatus {
-    if text.is_null() || pos.is_null() {
-        return kOfxStatErrValue;
-    }
-    // SAFETY: a NUL-terminated string and a point from the plugin.
-    let (text, pos) = unsafe { (CStr::from_ptr(text), &*pos) };
-    let call = DrawCall::Text {
-        text: text.to_string_lossy().into_owned(),
-        at: [pos.x, pos.y],
-        align,
-    };
-    record(h, "drawText", call)
+    super::guard::guard(kOfxStatErrUnknown, "draw_text", || {
+        if text.is_null() || pos.is_null() {
+            return kOfxStatErrValue;
+        }
+        // SAFETY: a NUL-terminated string and a point from the plugin.
+        let (text, pos) = unsafe { (CStr::from_ptr(text), &*pos) };
+        let call = DrawCall::Text {
+            text: text.to_string_lossy().into_owned(),
+            at: [pos.x, pos.y],
+            align,
+        };
+        record(h, "drawText", call)
+    })
 }
 
 /// The Draw suite this host offers when asked to.
@@ -206,31 +218,37 @@ unsafe fn interact<'a>(h: OfxInteractHandle) -> Option<&'a Interact> {
 }
 
 unsafe extern "C" fn swap_buffers(_: OfxInteractHandle) -> OfxStatus {
-    violation("interactSwapBuffers from an overlay (the host swaps)".into());
-    kOfxStatFailed
+    super::guard::guard(kOfxStatErrUnknown, "swap_buffers", || {
+        violation("interactSwapBuffers from an overlay (the host swaps)".into());
+        kOfxStatFailed
+    })
 }
 
 unsafe extern "C" fn redraw(h: OfxInteractHandle) -> OfxStatus {
-    // SAFETY: the plugin passes its interact's handle.
-    match unsafe { interact(h) } {
-        Some(i) => {
-            i.redraws.fetch_add(1, Ordering::AcqRel);
-            kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "redraw", || {
+        // SAFETY: the plugin passes its interact's handle.
+        match unsafe { interact(h) } {
+            Some(i) => {
+                i.redraws.fetch_add(1, Ordering::AcqRel);
+                kOfxStatOK
+            }
+            None => kOfxStatErrBadHandle,
         }
-        None => kOfxStatErrBadHandle,
-    }
+    })
 }
 
 unsafe extern "C" fn get_props(h: OfxInteractHandle, out: *mut OfxPropertySetHandle) -> OfxStatus {
-    // SAFETY: the plugin's interact handle, and its out-pointer.
-    match (unsafe { interact(h) }, out.is_null()) {
-        (Some(i), false) => {
-            // SAFETY: checked non-null.
-            unsafe { *out = i.props.handle() };
-            kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "get_props", || {
+        // SAFETY: the plugin's interact handle, and its out-pointer.
+        match (unsafe { interact(h) }, out.is_null()) {
+            (Some(i), false) => {
+                // SAFETY: checked non-null.
+                unsafe { *out = i.props.handle() };
+                kOfxStatOK
+            }
+            _ => kOfxStatErrBadHandle,
         }
-        _ => kOfxStatErrBadHandle,
-    }
+    })
 }
 
 /// The interact suite.

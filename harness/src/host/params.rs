@@ -196,34 +196,36 @@ unsafe extern "C" fn param_define(
     name: *const c_char,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    // SAFETY: set handles point at live ParamSets; strings are NUL-terminated.
-    let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if kind.is_null() || name.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: both checked non-null just above; OFX strings are NUL-terminated.
-    let (kind, name) = unsafe { (CStr::from_ptr(kind), CStr::from_ptr(name)) };
-    let name = name.to_string_lossy().into_owned();
-    let mut params = set.params.lock().unwrap_or_else(|e| e.into_inner());
-    if params.iter().any(|p| p.name == name) {
-        return kOfxStatErrExists;
-    }
-    let p = Box::new(Param {
-        name: name.clone(),
-        kind: kind.to_string_lossy().into_owned(),
-        props: PropertySet::new(),
-        state: Mutex::new(Default::default()),
-    });
-    p.props.set_str(kOfxParamPropType, &p.kind);
-    p.props.set_str(kOfxPropName, &name);
-    if !props.is_null() {
-        // SAFETY: non-null out-pointer from the plugin.
-        unsafe { *props = p.props.handle() };
-    }
-    params.push(p);
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "param_define", || {
+        // SAFETY: set handles point at live ParamSets; strings are NUL-terminated.
+        let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if kind.is_null() || name.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: both checked non-null just above; OFX strings are NUL-terminated.
+        let (kind, name) = unsafe { (CStr::from_ptr(kind), CStr::from_ptr(name)) };
+        let name = name.to_string_lossy().into_owned();
+        let mut params = set.params.lock().unwrap_or_else(|e| e.into_inner());
+        if params.iter().any(|p| p.name == name) {
+            return kOfxStatErrExists;
+        }
+        let p = Box::new(Param {
+            name: name.clone(),
+            kind: kind.to_string_lossy().into_owned(),
+            props: PropertySet::new(),
+            state: Mutex::new(Default::default()),
+        });
+        p.props.set_str(kOfxParamPropType, &p.kind);
+        p.props.set_str(kOfxPropName, &name);
+        if !props.is_null() {
+            // SAFETY: non-null out-pointer from the plugin.
+            unsafe { *props = p.props.handle() };
+        }
+        params.push(p);
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn param_get_handle(
@@ -232,83 +234,93 @@ unsafe extern "C" fn param_get_handle(
     param: *mut OfxParamHandle,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    // SAFETY: set handles point at live ParamSets; name NUL-terminated.
-    let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if name.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: checked non-null just above; OFX strings are NUL-terminated.
-    let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
-    let Some(p) = set.find(&name) else {
-        return kOfxStatErrUnknown;
-    };
-    // SAFETY: out-pointers are the plugin's; `p` is a live boxed Param.
-    unsafe {
-        if !param.is_null() {
-            *param = p as OfxParamHandle;
+    super::guard::guard(kOfxStatErrUnknown, "param_get_handle", || {
+        // SAFETY: set handles point at live ParamSets; name NUL-terminated.
+        let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if name.is_null() {
+            return kOfxStatErrBadHandle;
         }
-        if !props.is_null() {
-            *props = (*p).props.handle();
+        // SAFETY: checked non-null just above; OFX strings are NUL-terminated.
+        let name = unsafe { CStr::from_ptr(name) }.to_string_lossy();
+        let Some(p) = set.find(&name) else {
+            return kOfxStatErrUnknown;
+        };
+        // SAFETY: out-pointers are the plugin's; `p` is a live boxed Param.
+        unsafe {
+            if !param.is_null() {
+                *param = p as OfxParamHandle;
+            }
+            if !props.is_null() {
+                *props = (*p).props.handle();
+            }
         }
-    }
-    kOfxStatOK
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn param_set_props(
     set: OfxParamSetHandle,
     props: *mut OfxPropertySetHandle,
 ) -> OfxStatus {
-    // SAFETY: set handles point at live ParamSets.
-    let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if !props.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *props = set.props.handle() };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "param_set_props", || {
+        // SAFETY: set handles point at live ParamSets.
+        let Some(set) = (unsafe { (set as *const ParamSet).as_ref() }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if !props.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *props = set.props.handle() };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn param_props(h: OfxParamHandle, props: *mut OfxPropertySetHandle) -> OfxStatus {
-    // SAFETY: see `param_of`.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if !props.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *props = p.props.handle() };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "param_props", || {
+        // SAFETY: see `param_of`.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if !props.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *props = p.props.handle() };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn num_keys(h: OfxParamHandle, n: *mut c_uint) -> OfxStatus {
-    // SAFETY: see `param_of`.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    if !n.is_null() {
-        // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
-        unsafe { *n = p.num_keys() as c_uint };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "num_keys", || {
+        // SAFETY: see `param_of`.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        if !n.is_null() {
+            // SAFETY: checked non-null just above; the plugin passes a pointer to its own variable.
+            unsafe { *n = p.num_keys() as c_uint };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn key_time(h: OfxParamHandle, nth: c_uint, time: *mut OfxTime) -> OfxStatus {
-    // SAFETY: see `param_of`.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    match p.key_times().get(nth as usize) {
-        None => kOfxStatErrBadIndex,
-        Some(_) if time.is_null() => kOfxStatErrBadIndex,
-        Some(t) => {
-            // SAFETY: checked non-null; the plugin's own variable.
-            unsafe { *time = *t };
-            kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "key_time", || {
+        // SAFETY: see `param_of`.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        match p.key_times().get(nth as usize) {
+            None => kOfxStatErrBadIndex,
+            Some(_) if time.is_null() => kOfxStatErrBadIndex,
+            Some(t) => {
+                // SAFETY: checked non-null; the plugin's own variable.
+                unsafe { *time = *t };
+                kOfxStatOK
+            }
         }
-    }
+    })
 }
 unsafe extern "C" fn unsupported_key_index(
     _: OfxParamHandle,
@@ -316,19 +328,25 @@ unsafe extern "C" fn unsupported_key_index(
     _: c_int,
     _: *mut c_int,
 ) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "unsupported_key_index", || {
+        kOfxStatErrUnsupported
+    })
 }
 unsafe extern "C" fn unsupported_delete_key(_: OfxParamHandle, _: OfxTime) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "unsupported_delete_key", || {
+        kOfxStatErrUnsupported
+    })
 }
 unsafe extern "C" fn delete_all_keys(h: OfxParamHandle) -> OfxStatus {
-    // SAFETY: see `param_of`.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    let v = p.value_at(0.0);
-    p.set(v);
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "delete_all_keys", || {
+        // SAFETY: see `param_of`.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        let v = p.value_at(0.0);
+        p.set(v);
+        kOfxStatOK
+    })
 }
 unsafe extern "C" fn unsupported_copy(
     _: OfxParamHandle,
@@ -336,7 +354,9 @@ unsafe extern "C" fn unsupported_copy(
     _: OfxTime,
     _: *const OfxRangeD,
 ) -> OfxStatus {
-    kOfxStatErrUnsupported
+    super::guard::guard(kOfxStatErrUnknown, "unsupported_copy", || {
+        kOfxStatErrUnsupported
+    })
 }
 thread_local! {
     /// The plugin's param writes and edit blocks on this thread, in order
@@ -405,31 +425,35 @@ fn log_edit(entry: String) {
 }
 
 unsafe extern "C" fn edit(_: OfxParamSetHandle) -> OfxStatus {
-    let open = EDITS.with(|e| {
-        let mut e = e.borrow_mut();
-        let open = e.0 > 0;
-        e.0 = e.0.saturating_sub(1);
-        open
-    });
-    if !open {
-        super::violation("paramEditEnd without a paramEditBegin".into());
-        return kOfxStatFailed;
-    }
-    log_edit("end".into());
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "edit", || {
+        let open = EDITS.with(|e| {
+            let mut e = e.borrow_mut();
+            let open = e.0 > 0;
+            e.0 = e.0.saturating_sub(1);
+            open
+        });
+        if !open {
+            super::violation("paramEditEnd without a paramEditBegin".into());
+            return kOfxStatFailed;
+        }
+        log_edit("end".into());
+        kOfxStatOK
+    })
 }
 unsafe extern "C" fn edit_begin(_: OfxParamSetHandle, name: *const c_char) -> OfxStatus {
-    let name = if name.is_null() {
-        String::new()
-    } else {
-        // SAFETY: a NUL-terminated name from the plugin.
-        unsafe { CStr::from_ptr(name) }
-            .to_string_lossy()
-            .into_owned()
-    };
-    EDITS.with(|e| e.borrow_mut().0 += 1);
-    log_edit(format!("begin {name}"));
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "edit_begin", || {
+        let name = if name.is_null() {
+            String::new()
+        } else {
+            // SAFETY: a NUL-terminated name from the plugin.
+            unsafe { CStr::from_ptr(name) }
+                .to_string_lossy()
+                .into_owned()
+        };
+        EDITS.with(|e| e.borrow_mut().0 += 1);
+        log_edit(format!("begin {name}"));
+        kOfxStatOK
+    })
 }
 
 // The C shim (varargs.c) unpacks variadic arguments through these.
@@ -442,22 +466,24 @@ pub unsafe extern "C" fn mfx_param_shape(
     kind: *mut c_int,
     dim: *mut c_int,
 ) -> c_int {
-    // SAFETY: see `param_of`; out-pointers are the shim's locals.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    let (k, d) = match p.shape() {
-        Shape::Double(n) => (0, n),
-        Shape::Int(n) => (1, n),
-        Shape::Str => (2, 1),
-        Shape::None => return kOfxStatErrValue,
-    };
-    // SAFETY: the C shim passes pointers to its own locals (see varargs.c).
-    unsafe {
-        *kind = k;
-        *dim = d as c_int;
-    }
-    kOfxStatOK
+    super::guard::guard(0, "mfx_param_shape", || {
+        // SAFETY: see `param_of`; out-pointers are the shim's locals.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        let (k, d) = match p.shape() {
+            Shape::Double(n) => (0, n),
+            Shape::Int(n) => (1, n),
+            Shape::Str => (2, 1),
+            Shape::None => return kOfxStatErrValue,
+        };
+        // SAFETY: the C shim passes pointers to its own locals (see varargs.c).
+        unsafe {
+            *kind = k;
+            *dim = d as c_int;
+        }
+        kOfxStatOK
+    })
 }
 
 /// # Safety
@@ -471,28 +497,30 @@ pub unsafe extern "C" fn mfx_param_get(
     iv: *mut c_int,
     s: *mut *const c_char,
 ) -> c_int {
-    // SAFETY: see `param_of`.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    let v = p.value_at(if at_time != 0 { time } else { 0.0 });
-    // SAFETY: the shim's arrays hold 4 values; the string pointer stays valid
-    // because the param keeps an equal CString until it is set again — we
-    // return the stored one, not the copy.
-    unsafe {
-        for k in 0..4 {
-            *d.add(k) = v.d[k];
-            *iv.add(k) = v.i[k];
+    super::guard::guard(0, "mfx_param_get", || {
+        // SAFETY: see `param_of`.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        let v = p.value_at(if at_time != 0 { time } else { 0.0 });
+        // SAFETY: the shim's arrays hold 4 values; the string pointer stays valid
+        // because the param keeps an equal CString until it is set again — we
+        // return the stored one, not the copy.
+        unsafe {
+            for k in 0..4 {
+                *d.add(k) = v.d[k];
+                *iv.add(k) = v.i[k];
+            }
+            let st = p.state();
+            let stored =
+                st.1.iter()
+                    .find(|(_, kv)| kv.s == v.s)
+                    .map(|(_, kv)| &kv.s)
+                    .unwrap_or(&st.0.s);
+            *s = stored.as_ptr();
         }
-        let st = p.state();
-        let stored =
-            st.1.iter()
-                .find(|(_, kv)| kv.s == v.s)
-                .map(|(_, kv)| &kv.s)
-                .unwrap_or(&st.0.s);
-        *s = stored.as_ptr();
-    }
-    kOfxStatOK
+        kOfxStatOK
+    })
 }
 
 /// # Safety
@@ -506,30 +534,32 @@ pub unsafe extern "C" fn mfx_param_set(
     iv: *const c_int,
     s: *const c_char,
 ) -> c_int {
-    // SAFETY: see `param_of`; arrays hold 4 values.
-    let Some(p) = (unsafe { param_of(h) }) else {
-        return kOfxStatErrBadHandle;
-    };
-    let mut v = ParamValue::default();
-    // SAFETY: the caller's `d` and `iv` point at four values each.
-    unsafe {
-        for k in 0..4 {
-            v.d[k] = *d.add(k);
-            v.i[k] = *iv.add(k);
+    super::guard::guard(0, "mfx_param_set", || {
+        // SAFETY: see `param_of`; arrays hold 4 values.
+        let Some(p) = (unsafe { param_of(h) }) else {
+            return kOfxStatErrBadHandle;
+        };
+        let mut v = ParamValue::default();
+        // SAFETY: the caller's `d` and `iv` point at four values each.
+        unsafe {
+            for k in 0..4 {
+                v.d[k] = *d.add(k);
+                v.i[k] = *iv.add(k);
+            }
+            if !s.is_null() {
+                v.s = CStr::from_ptr(s).to_owned();
+            }
         }
-        if !s.is_null() {
-            v.s = CStr::from_ptr(s).to_owned();
+        check_write_allowed(&p.name);
+        if at_time != 0 {
+            log_edit(format!("set {}@{time}", p.name));
+            p.set_key(time, v);
+        } else {
+            log_edit(format!("set {}", p.name));
+            p.set(v);
         }
-    }
-    check_write_allowed(&p.name);
-    if at_time != 0 {
-        log_edit(format!("set {}@{time}", p.name));
-        p.set_key(time, v);
-    } else {
-        log_edit(format!("set {}", p.name));
-        p.set(v);
-    }
-    kOfxStatOK
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" {

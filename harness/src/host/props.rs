@@ -133,33 +133,35 @@ macro_rules! setter {
             index: c_int,
             value: $t,
         ) -> OfxStatus {
-            // SAFETY: handles we hand out are live PropertySets.
-            let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
-                return kOfxStatErrBadHandle;
-            };
-            if index < 0 {
-                return kOfxStatErrBadIndex;
-            }
-            let conv: fn($t) -> _ = $conv;
-            let v = conv(value);
-            let mut map = set.map();
-            let entry = map
-                .entry(name)
-                .or_insert_with(|| Value::$variant(Vec::new()));
-            let Value::$variant(vec) = entry else {
-                *entry = Value::$variant(Vec::new());
-                let Value::$variant(vec) = entry else {
-                    unreachable!()
+            super::guard::guard(kOfxStatErrUnknown, stringify!($fn), || {
+                // SAFETY: handles we hand out are live PropertySets.
+                let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
+                    return kOfxStatErrBadHandle;
                 };
-                vec.resize_with(index as usize + 1, Default::default);
+                if index < 0 {
+                    return kOfxStatErrBadIndex;
+                }
+                let conv: fn($t) -> _ = $conv;
+                let v = conv(value);
+                let mut map = set.map();
+                let entry = map
+                    .entry(name)
+                    .or_insert_with(|| Value::$variant(Vec::new()));
+                let Value::$variant(vec) = entry else {
+                    *entry = Value::$variant(Vec::new());
+                    let Value::$variant(vec) = entry else {
+                        unreachable!()
+                    };
+                    vec.resize_with(index as usize + 1, Default::default);
+                    vec[index as usize] = v;
+                    return kOfxStatOK;
+                };
+                if vec.len() <= index as usize {
+                    vec.resize_with(index as usize + 1, Default::default);
+                }
                 vec[index as usize] = v;
-                return kOfxStatOK;
-            };
-            if vec.len() <= index as usize {
-                vec.resize_with(index as usize + 1, Default::default);
-            }
-            vec[index as usize] = v;
-            kOfxStatOK
+                kOfxStatOK
+            })
         }
     };
 }
@@ -181,35 +183,39 @@ unsafe extern "C" fn get_any(
     out: *mut c_void,
     kind: u8,
 ) -> OfxStatus {
-    // SAFETY: handles we hand out are live PropertySets.
-    let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
-        return kOfxStatErrBadHandle;
-    };
-    if out.is_null() || index < 0 {
-        return kOfxStatErrBadIndex;
-    }
-    let map = set.map();
-    let Some(v) = map.get(&name) else {
-        return kOfxStatErrUnknown;
-    };
-    let i = index as usize;
-    // SAFETY: (all arms) `out` points at the plugin's variable of the type the
-    // called getter names; string pointers stay valid until the property is set again.
-    unsafe {
-        match (kind, v) {
-            (b's', Value::S(v)) if i < v.len() => *(out as *mut *const c_char) = v[i].as_ptr(),
-            (b'i', Value::I(v)) if i < v.len() => *(out as *mut c_int) = v[i],
-            (b'd', Value::D(v)) if i < v.len() => *(out as *mut f64) = v[i],
-            (b'd', Value::I(v)) if i < v.len() => *(out as *mut f64) = v[i] as f64,
-            (b'p', Value::P(v)) if i < v.len() => *(out as *mut *mut c_void) = v[i] as *mut c_void,
-            (_, Value::S(v)) if i >= v.len() => return kOfxStatErrBadIndex,
-            (_, Value::I(v)) if i >= v.len() => return kOfxStatErrBadIndex,
-            (_, Value::D(v)) if i >= v.len() => return kOfxStatErrBadIndex,
-            (_, Value::P(v)) if i >= v.len() => return kOfxStatErrBadIndex,
-            _ => return kOfxStatErrValue,
+    super::guard::guard(kOfxStatErrUnknown, "get_any", || {
+        // SAFETY: handles we hand out are live PropertySets.
+        let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
+            return kOfxStatErrBadHandle;
+        };
+        if out.is_null() || index < 0 {
+            return kOfxStatErrBadIndex;
         }
-    }
-    kOfxStatOK
+        let map = set.map();
+        let Some(v) = map.get(&name) else {
+            return kOfxStatErrUnknown;
+        };
+        let i = index as usize;
+        // SAFETY: (all arms) `out` points at the plugin's variable of the type the
+        // called getter names; string pointers stay valid until the property is set again.
+        unsafe {
+            match (kind, v) {
+                (b's', Value::S(v)) if i < v.len() => *(out as *mut *const c_char) = v[i].as_ptr(),
+                (b'i', Value::I(v)) if i < v.len() => *(out as *mut c_int) = v[i],
+                (b'd', Value::D(v)) if i < v.len() => *(out as *mut f64) = v[i],
+                (b'd', Value::I(v)) if i < v.len() => *(out as *mut f64) = v[i] as f64,
+                (b'p', Value::P(v)) if i < v.len() => {
+                    *(out as *mut *mut c_void) = v[i] as *mut c_void
+                }
+                (_, Value::S(v)) if i >= v.len() => return kOfxStatErrBadIndex,
+                (_, Value::I(v)) if i >= v.len() => return kOfxStatErrBadIndex,
+                (_, Value::D(v)) if i >= v.len() => return kOfxStatErrBadIndex,
+                (_, Value::P(v)) if i >= v.len() => return kOfxStatErrBadIndex,
+                _ => return kOfxStatErrValue,
+            }
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn get_string(
@@ -218,8 +224,10 @@ unsafe extern "C" fn get_string(
     i: c_int,
     out: *mut *mut c_char,
 ) -> OfxStatus {
-    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
-    unsafe { get_any(h, n, i, out as *mut c_void, b's') }
+    super::guard::guard(kOfxStatErrUnknown, "get_string", || {
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        unsafe { get_any(h, n, i, out as *mut c_void, b's') }
+    })
 }
 unsafe extern "C" fn get_int(
     h: OfxPropertySetHandle,
@@ -227,8 +235,10 @@ unsafe extern "C" fn get_int(
     i: c_int,
     out: *mut c_int,
 ) -> OfxStatus {
-    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
-    unsafe { get_any(h, n, i, out as *mut c_void, b'i') }
+    super::guard::guard(kOfxStatErrUnknown, "get_int", || {
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        unsafe { get_any(h, n, i, out as *mut c_void, b'i') }
+    })
 }
 unsafe extern "C" fn get_double(
     h: OfxPropertySetHandle,
@@ -236,8 +246,10 @@ unsafe extern "C" fn get_double(
     i: c_int,
     out: *mut f64,
 ) -> OfxStatus {
-    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
-    unsafe { get_any(h, n, i, out as *mut c_void, b'd') }
+    super::guard::guard(kOfxStatErrUnknown, "get_double", || {
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        unsafe { get_any(h, n, i, out as *mut c_void, b'd') }
+    })
 }
 unsafe extern "C" fn get_pointer(
     h: OfxPropertySetHandle,
@@ -245,8 +257,10 @@ unsafe extern "C" fn get_pointer(
     i: c_int,
     out: *mut *mut c_void,
 ) -> OfxStatus {
-    // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
-    unsafe { get_any(h, n, i, out as *mut c_void, b'p') }
+    super::guard::guard(kOfxStatErrUnknown, "get_pointer", || {
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        unsafe { get_any(h, n, i, out as *mut c_void, b'p') }
+    })
 }
 
 unsafe extern "C" fn get_dimension(
@@ -254,31 +268,35 @@ unsafe extern "C" fn get_dimension(
     name: *const c_char,
     count: *mut c_int,
 ) -> OfxStatus {
-    // SAFETY: handles we hand out are live PropertySets.
-    let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
-        return kOfxStatErrBadHandle;
-    };
-    let n = match set.map().get(&name) {
-        Some(Value::S(v)) => v.len(),
-        Some(Value::I(v)) => v.len(),
-        Some(Value::D(v)) => v.len(),
-        Some(Value::P(v)) => v.len(),
-        None => return kOfxStatErrUnknown,
-    };
-    if !count.is_null() {
-        // SAFETY: non-null out-pointer from the plugin.
-        unsafe { *count = n as c_int };
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "get_dimension", || {
+        // SAFETY: handles we hand out are live PropertySets.
+        let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
+            return kOfxStatErrBadHandle;
+        };
+        let n = match set.map().get(&name) {
+            Some(Value::S(v)) => v.len(),
+            Some(Value::I(v)) => v.len(),
+            Some(Value::D(v)) => v.len(),
+            Some(Value::P(v)) => v.len(),
+            None => return kOfxStatErrUnknown,
+        };
+        if !count.is_null() {
+            // SAFETY: non-null out-pointer from the plugin.
+            unsafe { *count = n as c_int };
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn reset(h: OfxPropertySetHandle, name: *const c_char) -> OfxStatus {
-    // SAFETY: handles we hand out are live PropertySets.
-    let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
-        return kOfxStatErrBadHandle;
-    };
-    set.map().remove(&name);
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "reset", || {
+        // SAFETY: handles we hand out are live PropertySets.
+        let (Some(set), Some(name)) = (unsafe { set_of(h) }, name_of(name)) else {
+            return kOfxStatErrBadHandle;
+        };
+        set.map().remove(&name);
+        kOfxStatOK
+    })
 }
 
 macro_rules! multi {
@@ -289,14 +307,16 @@ macro_rules! multi {
             count: c_int,
             values: $t,
         ) -> OfxStatus {
-            for k in 0..count.max(0) {
-                // SAFETY: the plugin passes an array of `count` values.
-                let st = unsafe { $one(h, name, k, *values.add(k as usize)) };
-                if st != kOfxStatOK {
-                    return st;
+            super::guard::guard(kOfxStatErrUnknown, stringify!($fn), || {
+                for k in 0..count.max(0) {
+                    // SAFETY: the plugin passes an array of `count` values.
+                    let st = unsafe { $one(h, name, k, *values.add(k as usize)) };
+                    if st != kOfxStatOK {
+                        return st;
+                    }
                 }
-            }
-            kOfxStatOK
+                kOfxStatOK
+            })
         }
     };
 }
@@ -313,14 +333,16 @@ macro_rules! multi_get {
             count: c_int,
             values: $t,
         ) -> OfxStatus {
-            for k in 0..count.max(0) {
-                // SAFETY: the plugin passes room for `count` values.
-                let st = unsafe { $one(h, name, k, values.add(k as usize)) };
-                if st != kOfxStatOK {
-                    return st;
+            super::guard::guard(kOfxStatErrUnknown, stringify!($fn), || {
+                for k in 0..count.max(0) {
+                    // SAFETY: the plugin passes room for `count` values.
+                    let st = unsafe { $one(h, name, k, values.add(k as usize)) };
+                    if st != kOfxStatOK {
+                        return st;
+                    }
                 }
-            }
-            kOfxStatOK
+                kOfxStatOK
+            })
         }
     };
 }

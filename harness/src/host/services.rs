@@ -25,41 +25,45 @@ unsafe extern "C" fn memory_alloc(
     n_bytes: usize,
     out: *mut *mut c_void,
 ) -> OfxStatus {
-    if out.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    let Some(total) = n_bytes.checked_add(HEADER) else {
-        return kOfxStatErrMemory;
-    };
-    let Ok(layout) = Layout::from_size_align(total, HEADER) else {
-        return kOfxStatErrMemory;
-    };
-    // SAFETY: `layout` has a non-zero size (HEADER > 0).
-    let base = unsafe { std::alloc::alloc(layout) };
-    if base.is_null() {
-        return kOfxStatErrMemory;
-    }
-    // SAFETY: `base` is valid for `total >= HEADER` bytes and 16-aligned;
-    // `out` was checked non-null and points to the plugin's pointer slot.
-    unsafe {
-        (base as *mut usize).write(total);
-        *out = base.add(HEADER) as *mut c_void;
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "memory_alloc", || {
+        if out.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        let Some(total) = n_bytes.checked_add(HEADER) else {
+            return kOfxStatErrMemory;
+        };
+        let Ok(layout) = Layout::from_size_align(total, HEADER) else {
+            return kOfxStatErrMemory;
+        };
+        // SAFETY: `layout` has a non-zero size (HEADER > 0).
+        let base = unsafe { std::alloc::alloc(layout) };
+        if base.is_null() {
+            return kOfxStatErrMemory;
+        }
+        // SAFETY: `base` is valid for `total >= HEADER` bytes and 16-aligned;
+        // `out` was checked non-null and points to the plugin's pointer slot.
+        unsafe {
+            (base as *mut usize).write(total);
+            *out = base.add(HEADER) as *mut c_void;
+        }
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn memory_free(data: *mut c_void) -> OfxStatus {
-    if data.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: `data` came from `memory_alloc`, so HEADER bytes before it hold
-    // the block's total size and the block was allocated with this layout.
-    unsafe {
-        let base = (data as *mut u8).sub(HEADER);
-        let total = (base as *const usize).read();
-        std::alloc::dealloc(base, Layout::from_size_align_unchecked(total, HEADER));
-    }
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "memory_free", || {
+        if data.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: `data` came from `memory_alloc`, so HEADER bytes before it hold
+        // the block's total size and the block was allocated with this layout.
+        unsafe {
+            let base = (data as *mut u8).sub(HEADER);
+            let total = (base as *const usize).read();
+            std::alloc::dealloc(base, Layout::from_size_align_unchecked(total, HEADER));
+        }
+        kOfxStatOK
+    })
 }
 
 pub static MEMORY_SUITE: OfxMemorySuiteV1 = OfxMemorySuiteV1 {
@@ -83,51 +87,59 @@ unsafe extern "C" fn multi_thread(
     n_threads: c_uint,
     arg: *mut c_void,
 ) -> OfxStatus {
-    let Some(func) = func else {
-        return kOfxStatErrBadHandle;
-    };
-    let n = if n_threads == 0 { cpus() } else { n_threads };
-    let arg = arg as usize;
-    let panicked = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..n)
-            .map(|k| {
-                s.spawn(move || {
-                    THREAD_INDEX.with(|t| t.set(Some(k)));
-                    // SAFETY: the plugin's own function with its own argument,
-                    // called as the multi-thread suite specifies.
-                    unsafe { func(k, n, arg as *mut c_void) }
+    super::guard::guard(kOfxStatErrUnknown, "multi_thread", || {
+        let Some(func) = func else {
+            return kOfxStatErrBadHandle;
+        };
+        let n = if n_threads == 0 { cpus() } else { n_threads };
+        let arg = arg as usize;
+        let panicked = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..n)
+                .map(|k| {
+                    s.spawn(move || {
+                        THREAD_INDEX.with(|t| t.set(Some(k)));
+                        // SAFETY: the plugin's own function with its own argument,
+                        // called as the multi-thread suite specifies.
+                        unsafe { func(k, n, arg as *mut c_void) }
+                    })
                 })
-            })
-            .collect();
-        handles.into_iter().any(|h| h.join().is_err())
-    });
-    if panicked {
-        kOfxStatFailed
-    } else {
-        kOfxStatOK
-    }
+                .collect();
+            handles.into_iter().any(|h| h.join().is_err())
+        });
+        if panicked {
+            kOfxStatFailed
+        } else {
+            kOfxStatOK
+        }
+    })
 }
 
 unsafe extern "C" fn multi_thread_num_cpus(n: *mut c_uint) -> OfxStatus {
-    if n.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: checked non-null; the plugin passes a pointer to its variable.
-    unsafe { *n = cpus() };
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "multi_thread_num_cpus", || {
+        if n.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: checked non-null; the plugin passes a pointer to its variable.
+        unsafe { *n = cpus() };
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn multi_thread_index(index: *mut c_uint) -> OfxStatus {
-    if index.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: checked non-null.
-    unsafe { *index = THREAD_INDEX.with(|t| t.get()).unwrap_or(0) };
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "multi_thread_index", || {
+        if index.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: checked non-null.
+        unsafe { *index = THREAD_INDEX.with(|t| t.get()).unwrap_or(0) };
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn multi_thread_is_spawned() -> c_int {
-    THREAD_INDEX.with(|t| t.get()).is_some() as c_int
+    super::guard::guard(0, "multi_thread_is_spawned", || {
+        THREAD_INDEX.with(|t| t.get()).is_some() as c_int
+    })
 }
 
 /// A recursive mutex (OFX mutexes may be locked again by their owner).
@@ -177,53 +189,63 @@ unsafe fn mutex_of<'a>(m: OfxMutexHandle) -> Option<&'a RecursiveMutex> {
 }
 
 unsafe extern "C" fn mutex_create(out: *mut OfxMutexHandle, lock_count: c_int) -> OfxStatus {
-    if out.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    let m = Box::new(RecursiveMutex {
-        state: Mutex::new((None, 0)),
-        freed: Condvar::new(),
-    });
-    for _ in 0..lock_count.max(0) {
-        m.try_lock(true);
-    }
-    // SAFETY: checked non-null; ownership of the box passes to the handle.
-    unsafe { *out = Box::into_raw(m) as OfxMutexHandle };
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "mutex_create", || {
+        if out.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        let m = Box::new(RecursiveMutex {
+            state: Mutex::new((None, 0)),
+            freed: Condvar::new(),
+        });
+        for _ in 0..lock_count.max(0) {
+            m.try_lock(true);
+        }
+        // SAFETY: checked non-null; ownership of the box passes to the handle.
+        unsafe { *out = Box::into_raw(m) as OfxMutexHandle };
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn mutex_destroy(m: OfxMutexHandle) -> OfxStatus {
-    if m.is_null() {
-        return kOfxStatErrBadHandle;
-    }
-    // SAFETY: `m` came from `mutex_create` and is destroyed once.
-    drop(unsafe { Box::from_raw(m as *mut RecursiveMutex) });
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "mutex_destroy", || {
+        if m.is_null() {
+            return kOfxStatErrBadHandle;
+        }
+        // SAFETY: `m` came from `mutex_create` and is destroyed once.
+        drop(unsafe { Box::from_raw(m as *mut RecursiveMutex) });
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn mutex_lock(m: OfxMutexHandle) -> OfxStatus {
-    // SAFETY: see `mutex_of`.
-    match unsafe { mutex_of(m) } {
-        Some(m) if m.try_lock(true) => kOfxStatOK,
-        _ => kOfxStatErrBadHandle,
-    }
+    super::guard::guard(kOfxStatErrUnknown, "mutex_lock", || {
+        // SAFETY: see `mutex_of`.
+        match unsafe { mutex_of(m) } {
+            Some(m) if m.try_lock(true) => kOfxStatOK,
+            _ => kOfxStatErrBadHandle,
+        }
+    })
 }
 
 unsafe extern "C" fn mutex_unlock(m: OfxMutexHandle) -> OfxStatus {
-    // SAFETY: see `mutex_of`.
-    match unsafe { mutex_of(m) } {
-        Some(m) if m.unlock() => kOfxStatOK,
-        _ => kOfxStatErrBadHandle,
-    }
+    super::guard::guard(kOfxStatErrUnknown, "mutex_unlock", || {
+        // SAFETY: see `mutex_of`.
+        match unsafe { mutex_of(m) } {
+            Some(m) if m.unlock() => kOfxStatOK,
+            _ => kOfxStatErrBadHandle,
+        }
+    })
 }
 
 unsafe extern "C" fn mutex_try_lock(m: OfxMutexHandle) -> OfxStatus {
-    // SAFETY: see `mutex_of`.
-    match unsafe { mutex_of(m) } {
-        Some(m) if m.try_lock(false) => kOfxStatOK,
-        Some(_) => kOfxStatFailed,
-        None => kOfxStatErrBadHandle,
-    }
+    super::guard::guard(kOfxStatErrUnknown, "mutex_try_lock", || {
+        // SAFETY: see `mutex_of`.
+        match unsafe { mutex_of(m) } {
+            Some(m) if m.try_lock(false) => kOfxStatOK,
+            Some(_) => kOfxStatFailed,
+            None => kOfxStatErrBadHandle,
+        }
+    })
 }
 
 pub static MULTI_THREAD_SUITE: OfxMultiThreadSuiteV1 = OfxMultiThreadSuiteV1 {
@@ -254,51 +276,59 @@ unsafe extern "C" fn progress_start_v2(
     message: *const c_char,
     _id: *const c_char,
 ) -> OfxStatus {
-    let Some(e) = live_effect(instance) else {
-        return kOfxStatErrBadHandle;
-    };
-    // SAFETY: see `text`.
-    let label = unsafe { text(message) };
-    *e.progress.lock().unwrap_or_else(|p| p.into_inner()) = Some((label, 0.0));
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "progress_start_v2", || {
+        let Some(e) = live_effect(instance) else {
+            return kOfxStatErrBadHandle;
+        };
+        // SAFETY: see `text`.
+        let label = unsafe { text(message) };
+        *e.progress.lock().unwrap_or_else(|p| p.into_inner()) = Some((label, 0.0));
+        kOfxStatOK
+    })
 }
 
 unsafe extern "C" fn progress_start_v1(instance: *mut c_void, label: *const c_char) -> OfxStatus {
-    // SAFETY: same contract as V2 without a message id.
-    unsafe { progress_start_v2(instance, label, std::ptr::null()) }
+    super::guard::guard(kOfxStatErrUnknown, "progress_start_v1", || {
+        // SAFETY: same contract as V2 without a message id.
+        unsafe { progress_start_v2(instance, label, std::ptr::null()) }
+    })
 }
 
 unsafe extern "C" fn progress_update(instance: *mut c_void, progress: f64) -> OfxStatus {
-    let Some(e) = live_effect(instance) else {
-        return kOfxStatErrBadHandle;
-    };
-    match e
-        .progress
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .as_mut()
-    {
-        Some(task) => {
-            task.1 = progress.clamp(0.0, 1.0);
-            e.progress_log
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .push(task.1);
-            match *e.cancel_at.lock().unwrap_or_else(|p| p.into_inner()) {
-                Some(at) if task.1 >= at => kOfxStatReplyNo,
-                _ => kOfxStatOK,
+    super::guard::guard(kOfxStatErrUnknown, "progress_update", || {
+        let Some(e) = live_effect(instance) else {
+            return kOfxStatErrBadHandle;
+        };
+        match e
+            .progress
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .as_mut()
+        {
+            Some(task) => {
+                task.1 = progress.clamp(0.0, 1.0);
+                e.progress_log
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .push(task.1);
+                match *e.cancel_at.lock().unwrap_or_else(|p| p.into_inner()) {
+                    Some(at) if task.1 >= at => kOfxStatReplyNo,
+                    _ => kOfxStatOK,
+                }
             }
+            None => kOfxStatFailed,
         }
-        None => kOfxStatFailed,
-    }
+    })
 }
 
 unsafe extern "C" fn progress_end(instance: *mut c_void) -> OfxStatus {
-    let Some(e) = live_effect(instance) else {
-        return kOfxStatErrBadHandle;
-    };
-    *e.progress.lock().unwrap_or_else(|p| p.into_inner()) = None;
-    kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "progress_end", || {
+        let Some(e) = live_effect(instance) else {
+            return kOfxStatErrBadHandle;
+        };
+        *e.progress.lock().unwrap_or_else(|p| p.into_inner()) = None;
+        kOfxStatOK
+    })
 }
 
 pub static PROGRESS_SUITE_V1: OfxProgressSuiteV1 = OfxProgressSuiteV1 {
@@ -316,26 +346,30 @@ pub static PROGRESS_SUITE_V2: OfxProgressSuiteV2 = OfxProgressSuiteV2 {
 // ---- time line ----------------------------------------------------------
 
 unsafe extern "C" fn get_time(instance: *mut c_void, time: *mut f64) -> OfxStatus {
-    match live_effect(instance) {
-        Some(e) if !time.is_null() => {
-            let t = e.timeline.lock().unwrap_or_else(|p| p.into_inner()).0;
-            // SAFETY: checked non-null.
-            unsafe { *time = t };
-            kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "get_time", || {
+        match live_effect(instance) {
+            Some(e) if !time.is_null() => {
+                let t = e.timeline.lock().unwrap_or_else(|p| p.into_inner()).0;
+                // SAFETY: checked non-null.
+                unsafe { *time = t };
+                kOfxStatOK
+            }
+            _ => kOfxStatErrBadHandle,
         }
-        _ => kOfxStatErrBadHandle,
-    }
+    })
 }
 
 unsafe extern "C" fn goto_time(instance: *mut c_void, time: f64) -> OfxStatus {
-    match live_effect(instance) {
-        Some(e) if time.is_finite() => {
-            e.timeline.lock().unwrap_or_else(|p| p.into_inner()).0 = time;
-            kOfxStatOK
+    super::guard::guard(kOfxStatErrUnknown, "goto_time", || {
+        match live_effect(instance) {
+            Some(e) if time.is_finite() => {
+                e.timeline.lock().unwrap_or_else(|p| p.into_inner()).0 = time;
+                kOfxStatOK
+            }
+            Some(_) => kOfxStatErrValue,
+            None => kOfxStatErrBadHandle,
         }
-        Some(_) => kOfxStatErrValue,
-        None => kOfxStatErrBadHandle,
-    }
+    })
 }
 
 unsafe extern "C" fn get_time_bounds(
@@ -343,18 +377,20 @@ unsafe extern "C" fn get_time_bounds(
     first: *mut f64,
     last: *mut f64,
 ) -> OfxStatus {
-    match live_effect(instance) {
-        Some(e) if !first.is_null() && !last.is_null() => {
-            let (_, a, b) = *e.timeline.lock().unwrap_or_else(|p| p.into_inner());
-            // SAFETY: both checked non-null.
-            unsafe {
-                *first = a;
-                *last = b;
+    super::guard::guard(kOfxStatErrUnknown, "get_time_bounds", || {
+        match live_effect(instance) {
+            Some(e) if !first.is_null() && !last.is_null() => {
+                let (_, a, b) = *e.timeline.lock().unwrap_or_else(|p| p.into_inner());
+                // SAFETY: both checked non-null.
+                unsafe {
+                    *first = a;
+                    *last = b;
+                }
+                kOfxStatOK
             }
-            kOfxStatOK
+            _ => kOfxStatErrBadHandle,
         }
-        _ => kOfxStatErrBadHandle,
-    }
+    })
 }
 
 pub static TIME_LINE_SUITE: OfxTimeLineSuiteV1 = OfxTimeLineSuiteV1 {
