@@ -108,9 +108,64 @@ pub struct Header {
     pub compression: Option<Compression>,
 }
 
+/// The most pixels a plate may have: 16384 × 16384 (4 GiB as the float
+/// RGBA the render works in). A header asking for more is refused before any
+/// pixel is read, whatever the file's size: a corrupt or hostile header
+/// must not make the process ask for memory it cannot have.
+pub const MAX_PIXELS: usize = 1 << 28;
+
+fn check_size(
+    path: &Path,
+    what: &str,
+    (w, h): (usize, usize),
+) -> std::result::Result<(), HostError> {
+    if w.saturating_mul(h) > MAX_PIXELS {
+        return Err(HostError::bad(format!(
+            "{}: its {what} is {w}x{h} pixels, over morphfx's limit of {MAX_PIXELS} pixels (16384x16384) a plate",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// A zeroed image, or a clear error where memory for it cannot be had.
+fn image_buffer(
+    path: &Path,
+    bounds: RectI,
+    channels: usize,
+) -> std::result::Result<Image, HostError> {
+    let n = bounds.area().saturating_mul(channels);
+    let mut data = Vec::new();
+    data.try_reserve_exact(n).map_err(|_| {
+        HostError::failed(format!(
+            "{}: not enough memory for its {}x{} pixels",
+            path.display(),
+            bounds.width(),
+            bounds.height()
+        ))
+    })?;
+    data.resize(n, 0.0);
+    Ok(Image {
+        bounds,
+        channels,
+        data,
+    })
+}
+
 /// An image file's header only (for checking a whole sequence before
-/// rendering without reading it twice).
+/// rendering without reading it twice), its sizes checked.
 pub fn probe(path: &Path) -> std::result::Result<Header, HostError> {
+    let header = probe_unchecked(path)?;
+    check_size(
+        path,
+        "data window",
+        (header.bounds.width(), header.bounds.height()),
+    )?;
+    check_size(path, "display window", header.window.size)?;
+    Ok(header)
+}
+
+fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
     if !path.exists() {
         return Err(HostError::bad(format!("{}: no such file", path.display())));
     }
@@ -177,6 +232,7 @@ fn data_bounds(
 }
 
 fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
+    probe(path)?;
     let img = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -212,7 +268,7 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
         _ => (0..4).map(|k| (k < list.len()).then_some(k)).collect(),
     };
     let bounds = data_bounds(display, pos, (w, h));
-    let mut image = Image::new(bounds, 4);
+    let mut image = image_buffer(path, bounds, 4)?;
     let sources: Vec<Option<&FlatSamples>> = picks
         .iter()
         .map(|pick| pick.map(|k| &list[k].sample_data))
@@ -249,6 +305,7 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
 }
 
 fn read_other(path: &Path, colour: Colour) -> std::result::Result<Plate, HostError> {
+    probe(path)?;
     let img = ::image::open(path)
         .map_err(|e| HostError::bad(format!("{}: cannot read image: {e}", path.display())))?;
     let float = matches!(
@@ -265,7 +322,7 @@ fn read_other(path: &Path, colour: Colour) -> std::result::Result<Plate, HostErr
         }
     }
     let (w, h) = (rgba.width() as usize, rgba.height() as usize);
-    let mut image = Image::new(RectI::from_size(w, h), 4);
+    let mut image = image_buffer(path, RectI::from_size(w, h), 4)?;
     for (x, yr, p) in rgba.enumerate_pixels() {
         let j = h - 1 - yr as usize;
         let k = (j * w + x as usize) * 4;

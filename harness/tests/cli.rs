@@ -474,3 +474,44 @@ fn png_plates_are_decoded_from_srgb_and_png_outputs_encoded_unless_raw() {
         assert_eq!(back.get_pixel(5, 5).0, [128, 64, 255, 255], "{name}");
     }
 }
+
+/// A header that claims 32768 × 32768 pixels in a file of a few hundred
+/// bytes: refused from its header with the limit named, before any pixel
+/// is read or any memory asked for, and nothing written.
+#[test]
+fn a_plate_over_the_size_limit_is_refused_from_its_header() {
+    let d = tmp("huge");
+    let small = d.join("small.exr");
+    let img = Image::from_fn(RectI::from_size(4, 4), 4, |_, _, _| 0.5);
+    io::write(&small, &Plate::new(img, (4, 4)), ExrPrecision::Half).unwrap();
+    let mut bytes = std::fs::read(&small).unwrap();
+    for name in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
+        let at = bytes
+            .windows(name.len())
+            .position(|w| w == name)
+            .expect("the attribute")
+            + name.len()
+            + 4;
+        // xMax and yMax of the box.
+        bytes[at + 8..at + 12].copy_from_slice(&32767i32.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&32767i32.to_le_bytes());
+    }
+    let huge = d.join("huge.exr");
+    std::fs::write(&huge, &bytes).unwrap();
+    let out = d.join("out.exr");
+    let (code, err) = morphfx(&[
+        "warp",
+        "--line",
+        "1=10,10,20,10,10,10,20,10",
+        "--input",
+        huge.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("huge.exr") && err.contains("32768x32768") && err.contains("limit"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
