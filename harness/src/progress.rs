@@ -51,10 +51,21 @@ impl Progress {
             b.finish();
         }
         let secs = self.start.elapsed().as_secs_f64();
+        let peak = peak_memory_mib()
+            .map(|m| format!("; peak memory {m} MiB"))
+            .unwrap_or_default();
         eprintln!(
-            "{} frame(s) in {secs:.2} s ({:.2} fps): {breakdown}",
+            "{} frame(s) in {secs:.2} s ({:.2} fps): {breakdown}{peak}",
             self.total,
             self.total as f64 / secs.max(1e-9)
         );
     }
+}
+
+/// The process's peak resident size so far (Linux: `VmHWM`), MiB.
+pub fn peak_memory_mib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024)
 }
