@@ -152,12 +152,14 @@ impl RectI {
     /// Columns (0 when inverted).
     #[inline]
     pub fn width(&self) -> usize {
-        (self.x2 - self.x1).max(0) as usize
+        // In i64: a rectangle from i32::MIN to i32::MAX (a host's
+        // "infinite" region) is wider than an i32 holds.
+        (self.x2 as i64 - self.x1 as i64).max(0) as usize
     }
     /// Rows (0 when inverted).
     #[inline]
     pub fn height(&self) -> usize {
-        (self.y2 - self.y1).max(0) as usize
+        (self.y2 as i64 - self.y1 as i64).max(0) as usize
     }
     /// No pixel inside.
     #[inline]
@@ -167,7 +169,7 @@ impl RectI {
     /// Pixels inside.
     #[inline]
     pub fn area(&self) -> usize {
-        self.width() * self.height()
+        self.width().saturating_mul(self.height())
     }
     /// Every pixel of `other` is inside (an empty `other` always is).
     #[inline]

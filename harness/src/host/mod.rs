@@ -579,6 +579,9 @@ pub struct OutputSpec {
     /// This host renders the sequence in frame order on this instance
     /// (kOfxImageEffectPropSequentialRenderStatus = 1).
     pub sequential: bool,
+    /// Host misuse: send this render window, whatever the output image
+    /// covers (`None`: the image's bounds, in tiles).
+    pub window: Option<RectI>,
 }
 
 impl Default for OutputSpec {
@@ -591,6 +594,7 @@ impl Default for OutputSpec {
             tiles: 1,
             identity: true,
             sequential: false,
+            window: None,
         }
     }
 }
@@ -1109,6 +1113,9 @@ impl Instance<'_> {
             self.act(kOfxImageEffectActionRender, Some(&a), None)
                 .map(|_| ())
         };
+        if let Some(w) = spec.window {
+            return render_one(w);
+        }
         if windows.len() == 1 {
             return render_one(windows[0]);
         }

@@ -65,6 +65,12 @@ impl Instance {
             .ok_or_else(|| Failure::Failed("instance created without its params".into()))
     }
 
+    /// Frees what the instance caches: warps, weights, correspondences,
+    /// planes and the parsed scene. The warm starts of `thin-plate` and
+    /// `auto` stay: a few small grids (at most [`GRIDS_KEPT`] and
+    /// [`PLATES_KEPT`]), and what makes the next frame's solve fast when a
+    /// host purges between the frames of a sequence (our harness does, to
+    /// keep memory flat).
     pub fn purge(&self) {
         self.warps.clear();
         *self.scene.lock().unwrap_or_else(|e| e.into_inner()) = None;
@@ -74,11 +80,6 @@ impl Instance {
             .clear();
         self.correspondences.clear();
         self.weights.clear();
-        self.grids.lock().unwrap_or_else(|e| e.into_inner()).clear();
-        self.plates
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clear();
     }
 
     /// True the first time `what` is asked about.

@@ -132,6 +132,9 @@ fn scale_of(i: &ImageInfo) -> PixelScale {
     PixelScale::new(i.render_scale.0, i.render_scale.1, i.par)
 }
 
+/// The most pixels one render window may have.
+const MAX_RENDER_PIXELS: usize = 1 << 28;
+
 /// Everything one render reads from the host, and the images it holds.
 fn gather(
     kind: NodeKind,
@@ -141,6 +144,18 @@ fn gather(
 ) -> Outcome<(Request, Lent)> {
     let time = in_args.get_double(kOfxPropTime, 0)?;
     let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
+    let window = RectI::new(x1, y1, x2, y2);
+    if window.area() > MAX_RENDER_PIXELS {
+        // Maps and intermediate rows are sized by the window: refuse before
+        // asking for memory no machine has (an allocation failure would
+        // abort the host with the artist's session).
+        return Err(Failure::BadInput(format!(
+            "the render window is {}x{} pixels, over MorphFX's limit of {MAX_RENDER_PIXELS} \
+             (16384x16384): render it in tiles or at a lower render scale",
+            window.width(),
+            window.height()
+        )));
+    }
     let sequential = in_args
         .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
         .unwrap_or(0)
@@ -179,7 +194,7 @@ fn gather(
     };
     let request = Request {
         time,
-        window: RectI::new(x1, y1, x2, y2),
+        window,
         sequential,
         settings,
         inputs,
