@@ -150,8 +150,9 @@ fn points(v: &Value) -> Vec<Vec2> {
         .collect()
 }
 
-fn to_json(points: &[Vec2]) -> Value {
-    // Millipixel precision keeps the file readable.
+/// Points as a scene file holds them, to a thousandth of a pixel (which
+/// keeps the file readable).
+pub fn to_json(points: &[Vec2]) -> Value {
     let r = |v: f64| (v * 1000.0).round() / 1000.0;
     Value::from(
         points

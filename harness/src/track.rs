@@ -11,7 +11,6 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use morphfx::features::{Feature, FeatureKind, Side};
-use morphfx::geom::Vec2;
 use morphfx::scene::Scene;
 use morphfx::track::{track_side, Frames, Grey, Pyramid, SideEstimate, SideKey, TrackSettings};
 use serde_json::{json, Value};
@@ -20,6 +19,7 @@ use crate::host::HostError;
 use crate::io;
 use crate::progress::Progress;
 use crate::sequence::{frame_path, is_sequence};
+use crate::snap::to_json;
 
 /// What `track` was asked to do.
 pub struct Track<'a> {
@@ -259,8 +259,8 @@ impl Track<'_> {
             let interpolated = scene.features_at(frame as f64);
             let mut features = template.clone();
             for (i, f) in features.as_array_mut().into_iter().flatten().enumerate() {
-                f["a"] = points_json(interpolated[i].points(Side::A));
-                f["b"] = points_json(interpolated[i].points(Side::B));
+                f["a"] = to_json(interpolated[i].points(Side::A));
+                f["b"] = to_json(interpolated[i].points(Side::B));
                 if let Some(map) = f.as_object_mut() {
                     map.remove("track");
                 }
@@ -268,7 +268,7 @@ impl Track<'_> {
                 for (side, per_frame) in tracked {
                     let e = &per_frame[at][i];
                     let key = side_key(*side);
-                    f[key] = points_json(&e.points);
+                    f[key] = to_json(&e.points);
                     if !keyed {
                         let conf: Vec<f64> = e
                             .confidence
@@ -333,17 +333,6 @@ fn check_present(pattern: &str, first: i64, last: i64) -> Result<(), HostError> 
             missing.len() - 1
         ))),
     }
-}
-
-fn points_json(points: &[Vec2]) -> Value {
-    // Millipixel precision keeps the file readable.
-    let r = |v: f64| (v * 1000.0).round() / 1000.0;
-    Value::from(
-        points
-            .iter()
-            .map(|p| Value::from(vec![r(p.x), r(p.y)]))
-            .collect::<Vec<_>>(),
-    )
 }
 
 /// Per feature and side on standard error: mean confidence, and the frames

@@ -121,6 +121,20 @@ fn mutate(doc: &mut Value, place: usize, kind: u8, pick: usize) {
     }
 }
 
+/// `scene` rendered at `time` through a Morph node, its settings applied.
+fn render(scene: &str, time: f64) -> Result<Arc<Frame>, morphfx_harness::host::HostError> {
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let p = plate();
+    inst.connect("SourceA", p.clone()).unwrap();
+    inst.connect("SourceB", p).unwrap();
+    inst.set_project(48.0, 32.0);
+    inst.set_int("settings_from_scene", 1).unwrap();
+    inst.set_string("scene_text", scene).unwrap();
+    inst.render(time, OutputSpec::default())
+}
+
 fn plate() -> Arc<Still> {
     let img = Image::from_fn(RectI::from_size(48, 32), 4, |i, j, c| {
         if c == 3 {
@@ -141,17 +155,8 @@ fn plate() -> Arc<Still> {
 fn render_within(scene: String, time: f64) -> Result<(), String> {
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
-        let inst = bundle()
-            .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-            .unwrap();
-        let p = plate();
-        inst.connect("SourceA", p.clone()).unwrap();
-        inst.connect("SourceB", p).unwrap();
-        inst.set_project(48.0, 32.0);
-        inst.set_int("settings_from_scene", 1).unwrap();
-        inst.set_string("scene_text", &scene).unwrap();
         // A picture, or a failure status with a message: both fine.
-        let result = inst.render(time, OutputSpec::default());
+        let result = render(&scene, time);
         let _ = tx.send(result.map(|_| ()).map_err(|e| e.message));
     });
     match rx.recv_timeout(Duration::from_secs(30)) {
@@ -190,17 +195,7 @@ proptest! {
 #[test]
 fn every_unmutated_method_renders() {
     for method in METHODS {
-        let inst = bundle()
-            .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-            .unwrap();
-        let p = plate();
-        inst.connect("SourceA", p.clone()).unwrap();
-        inst.connect("SourceB", p).unwrap();
-        inst.set_project(48.0, 32.0);
-        inst.set_int("settings_from_scene", 1).unwrap();
-        inst.set_string("scene_text", &valid(method).to_string())
-            .unwrap();
-        inst.render(5.0, OutputSpec::default())
+        render(&valid(method).to_string(), 5.0)
             .unwrap_or_else(|e| panic!("{method}: {}", e.message));
     }
 }
