@@ -319,10 +319,18 @@ impl Warp for MffdWarp {
         if self.is_identity() {
             return WarpMap::identity(window, scale);
         }
-        let lo = scale.pixel_centre(window.x1, window.y1);
+        // Nodes on a lattice fixed in the image (every `grid` pixels from
+        // pixel 0), not started at the window: a tile then gets exactly the
+        // pixels the whole frame has there (hosts render in tiles).
+        let grid = self.mffd.grid.max(1.0);
+        let snap = |p: i32| (p as f64 / grid).floor() * grid;
+        let lo = Vec2::new(
+            (snap(window.x1) + 0.5) / scale.x,
+            (snap(window.y1) + 0.5) / scale.y,
+        );
         let hi = scale.pixel_centre(window.x2 - 1, window.y2 - 1);
         let unit = scale.pixel_centre(1, 1) - scale.pixel_centre(0, 0);
-        let mut nodes = NodeGrid::covering(lo, hi, unit * self.mffd.grid.max(1.0));
+        let mut nodes = NodeGrid::covering(lo, hi, unit * grid);
         nodes.fill_rows(|row| self.mffd.apply_all(row));
         nodes.map_window(window, scale)
     }

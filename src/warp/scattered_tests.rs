@@ -73,6 +73,38 @@ fn mffd_dense_map_stays_close_to_the_exact_composition() {
     assert!(worst < 0.05, "dense map off by {worst} px");
 }
 
+/// A host renders in tiles: each tile's map must be exactly the whole
+/// frame's there, whatever rows and columns the tile starts on, at any
+/// render scale (the nodes lie on a lattice fixed in the image).
+#[test]
+fn mffd_tiles_are_the_whole_frame_bit_for_bit() {
+    let pairs = smooth_pairs(4, 40, 256.0, 192.0, 12.0, 16.0);
+    let warp = MffdWarp {
+        mffd: Mffd::solve(&pairs, FRAME, &MffdSettings::default()),
+    };
+    for s in [1.0, 0.5, 0.25] {
+        let scale = PixelScale::new(s, s, 1.0);
+        let (w, h) = ((256.0 * s) as i32, (192.0 * s) as i32);
+        let whole = warp.map_window(RectI::new(0, 0, w, h), scale);
+        for tile in [
+            RectI::new(0, 3, w, 9),
+            RectI::new(5, 7, w - 3, h),
+            RectI::new(1, 1, 2, 2),
+        ] {
+            let part = warp.map_window(tile, scale);
+            for j in tile.y1..tile.y2 {
+                for i in tile.x1..tile.x2 {
+                    assert_eq!(
+                        part.get(i, j),
+                        whole.get(i, j),
+                        "scale {s}, {tile:?}, ({i}, {j})"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn a_deformation_is_its_two_lattices_everywhere() {
     // The packed evaluation (both lattices interleaved, zero cells skipped)
