@@ -433,18 +433,20 @@ pub fn write_as(
 
 fn rgba_at(plate: &Plate, x: usize, row_from_top: usize) -> [f32; 4] {
     let img = &plate.image;
-    let (w, h) = (img.width(), img.height());
-    let j = h - 1 - row_from_top;
-    let k = (j * w + x) * img.channels;
-    match img.channels {
-        1 => [img.data[k]; 4],
-        3 => [img.data[k], img.data[k + 1], img.data[k + 2], 1.0],
-        _ => [
-            img.data[k],
-            img.data[k + 1],
-            img.data[k + 2],
-            img.data[k + 3],
-        ],
+    let (w, h, c) = (img.width(), img.height(), img.channels);
+    let k = ((h - 1 - row_from_top) * w + x) * c;
+    rgba(&img.data[k..k + c])
+}
+
+/// A pixel of 1 to 4 channels as RGBA, the way every writer stores it: one
+/// channel in all four, grey and alpha, RGB opaque.
+pub(crate) fn rgba(px: &[f32]) -> [f32; 4] {
+    match *px {
+        [v] => [v; 4],
+        [g, a] => [g, g, g, a],
+        [r, g, b] => [r, g, b, 1.0],
+        [r, g, b, a, ..] => [r, g, b, a],
+        [] => [0.0; 4],
     }
 }
 

@@ -3,7 +3,6 @@
 use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
@@ -17,7 +16,7 @@ use morphfx_harness::host::{
     Bundle, ErrorKind, Frame, FrameSource, HostError, HostOptions, Instance, OutputSpec,
 };
 use morphfx_harness::io::{self, ExrPrecision, Plate};
-use morphfx_harness::pipeline::WriteBehind;
+use morphfx_harness::pipeline::{ReadAhead, WriteBehind};
 use morphfx_harness::progress::Progress;
 use morphfx_harness::sequence::{frame_path, is_sequence, parse_frames};
 use morphfx_harness::snap::Snap;
@@ -488,8 +487,8 @@ struct Plates {
     pattern: String,
     colour: io::Colour,
     cache: Mutex<Vec<CachedPlate>>,
-    /// A frame being read ahead on another thread.
-    ahead: Mutex<Option<(i64, Reading)>>,
+    /// The next frame, read ahead on another thread.
+    ahead: Mutex<ReadAhead<Loaded>>,
     /// Time spent reading files, for the end-of-run summary.
     read_time: Mutex<Duration>,
     /// The first read that failed: the plugin only learns "no image", so the
@@ -500,16 +499,13 @@ struct Plates {
 /// A plate as the host hands it over, with its display window's size.
 type Loaded = (Arc<Frame>, (usize, usize));
 
-/// A plate being read on another thread.
-type Reading = JoinHandle<Result<Loaded, HostError>>;
-
 impl Plates {
     fn new(pattern: &str, colour: io::Colour) -> Arc<Plates> {
         Arc::new(Plates {
             pattern: pattern.to_owned(),
             colour,
             cache: Mutex::new(Vec::new()),
-            ahead: Mutex::new(None),
+            ahead: Mutex::new(ReadAhead::default()),
             read_time: Mutex::new(Duration::ZERO),
             error: Mutex::new(None),
         })
@@ -537,18 +533,14 @@ impl Plates {
         let frame = self.file_frame(frame);
         let mut ahead = lock(&self.ahead);
         // A frame read ahead but never asked for (the plugin did not need
-        // it) is kept in the cache once read, and makes room.
-        if let Some((k, job)) = ahead.take_if(|(_, job)| job.is_finished()) {
-            if let Ok(Ok(loaded)) = job.join() {
-                self.keep(k, &loaded);
-            }
+        // it) is kept once read, and makes room.
+        if let Some((k, Ok(loaded))) = ahead.take_finished() {
+            self.keep(k, &loaded);
         }
-        let cached = lock(&self.cache).iter().any(|(k, _, _)| *k == frame);
-        if cached || ahead.is_some() {
-            return;
+        if !lock(&self.cache).iter().any(|(k, _, _)| *k == frame) {
+            let me = self.clone();
+            ahead.start(frame, move || me.load(frame));
         }
-        let me = self.clone();
-        *ahead = Some((frame, std::thread::spawn(move || me.load(frame))));
     }
 
     fn plate(&self, frame: i64) -> Result<Loaded, HostError> {
@@ -556,16 +548,12 @@ impl Plates {
         if let Some((_, f, size)) = lock(&self.cache).iter().find(|(k, _, _)| *k == frame) {
             return Ok((f.clone(), *size));
         }
-        let pending = lock(&self.ahead).take_if(|(k, _)| *k == frame);
-        let loaded = match pending {
-            Some((_, job)) => job
-                .join()
-                .map_err(|_| HostError::failed("the plate reader panicked"))?,
-            None => self.load(frame),
-        }
-        .inspect_err(|e| {
-            lock(&self.error).get_or_insert_with(|| e.clone());
-        })?;
+        let pending = lock(&self.ahead).take(frame);
+        let loaded = pending
+            .unwrap_or_else(|| self.load(frame))
+            .inspect_err(|e| {
+                lock(&self.error).get_or_insert_with(|| e.clone());
+            })?;
         self.keep(frame, &loaded);
         Ok(loaded)
     }

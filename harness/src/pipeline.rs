@@ -1,7 +1,10 @@
-//! Frames written behind the render: a writer thread takes finished frames
-//! from a bounded queue (memory stays bounded: at most `depth` frames wait),
-//! writes them in order, each atomically, and the first failure stops the
-//! run at the next frame, with the file named.
+//! Frames read ahead of and written behind the work on them.
+//!
+//! [`ReadAhead`]: the next frame a sequence will ask for, read on another
+//! thread. [`WriteBehind`]: a writer thread takes finished frames from a
+//! bounded queue (memory stays bounded: at most `depth` frames wait), writes
+//! them in order, each atomically, and the first failure stops the run at
+//! the next frame, with the file named.
 
 use std::path::PathBuf;
 use std::sync::mpsc::{sync_channel, SyncSender};
@@ -11,6 +14,48 @@ use std::time::{Duration, Instant};
 
 use crate::host::HostError;
 use crate::io::{self, OutputFormat, Plate};
+
+/// One frame being read on another thread, ahead of need.
+pub struct ReadAhead<T> {
+    pending: Option<(i64, JoinHandle<Result<T, HostError>>)>,
+}
+
+impl<T: Send + 'static> Default for ReadAhead<T> {
+    fn default() -> Self {
+        ReadAhead { pending: None }
+    }
+}
+
+impl<T: Send + 'static> ReadAhead<T> {
+    /// Starts `load`ing `frame` on another thread, unless a read is under way.
+    pub fn start(
+        &mut self,
+        frame: i64,
+        load: impl FnOnce() -> Result<T, HostError> + Send + 'static,
+    ) {
+        if self.pending.is_none() {
+            self.pending = Some((frame, std::thread::spawn(load)));
+        }
+    }
+
+    /// `frame`, waited for, when it is the one being read; `None` otherwise.
+    pub fn take(&mut self, frame: i64) -> Option<Result<T, HostError>> {
+        let (_, job) = self.pending.take_if(|(f, _)| *f == frame)?;
+        Some(joined(job))
+    }
+
+    /// A read that finished but was never asked for (the reader did not
+    /// need that frame), to keep or drop; it makes room for the next.
+    pub fn take_finished(&mut self) -> Option<(i64, Result<T, HostError>)> {
+        let (frame, job) = self.pending.take_if(|(_, job)| job.is_finished())?;
+        Some((frame, joined(job)))
+    }
+}
+
+fn joined<T>(job: JoinHandle<Result<T, HostError>>) -> Result<T, HostError> {
+    job.join()
+        .map_err(|_| HostError::failed("a frame reader panicked"))?
+}
 
 type Job = (PathBuf, Plate, OutputFormat);
 

@@ -8,7 +8,6 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::thread::JoinHandle;
 
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::scene::Scene;
@@ -17,6 +16,7 @@ use serde_json::{json, Value};
 
 use crate::host::HostError;
 use crate::io;
+use crate::pipeline::ReadAhead;
 use crate::progress::Progress;
 use crate::sequence::{frame_path, is_sequence};
 use crate::snap::to_json;
@@ -38,25 +38,29 @@ pub struct Track<'a> {
 struct Reader {
     pattern: String,
     levels: usize,
-    /// Frames strictly between two keys: swept forward, then backward.
+    /// Frames a later sweep comes back to: the keys, and the frames
+    /// between two keys.
     revisited: Vec<(i64, i64)>,
     cache: HashMap<i64, Arc<Pyramid>>,
-    ahead: Option<(i64, Loading)>,
+    ahead: ReadAhead<Arc<Pyramid>>,
     last: Option<i64>,
     range: (i64, i64),
 }
-
-/// A frame being read on another thread.
-type Loading = JoinHandle<Result<Arc<Pyramid>, HostError>>;
 
 impl Reader {
     fn new(pattern: &str, levels: usize, keys: &[i64], range: (i64, i64)) -> Reader {
         Reader {
             pattern: pattern.to_string(),
             levels,
-            revisited: keys.windows(2).map(|w| (w[0] + 1, w[1] - 1)).collect(),
+            // Keys start a sweep each way; frames between keys are swept
+            // forward, then backward.
+            revisited: keys
+                .iter()
+                .map(|&k| (k, k))
+                .chain(keys.windows(2).map(|w| (w[0] + 1, w[1] - 1)))
+                .collect(),
             cache: HashMap::new(),
-            ahead: None,
+            ahead: ReadAhead::default(),
             last: None,
             range,
         }
@@ -77,13 +81,12 @@ impl Reader {
 
 impl Frames<HostError> for Reader {
     fn pyramid(&mut self, frame: i64) -> Result<Arc<Pyramid>, HostError> {
-        let ahead = self.ahead.take_if(|(f, _)| *f == frame);
-        let pyramid = match (self.cache.get(&frame), ahead) {
-            (Some(p), _) => p.clone(),
-            (None, Some((_, job))) => job
-                .join()
-                .map_err(|_| HostError::failed("the frame reader stopped"))??,
-            (None, None) => Reader::load(&self.pattern, frame, self.levels)?,
+        let pyramid = match self.cache.get(&frame) {
+            Some(p) => p.clone(),
+            None => match self.ahead.take(frame) {
+                Some(read) => read?,
+                None => Reader::load(&self.pattern, frame, self.levels)?,
+            },
         };
         if self.revisited(frame) {
             self.cache.insert(frame, pyramid.clone());
@@ -92,10 +95,10 @@ impl Frames<HostError> for Reader {
         let next = frame + self.last.map_or(1, |l| (frame - l).signum());
         self.last = Some(frame);
         let (lo, hi) = self.range;
-        if self.ahead.is_none() && (lo..=hi).contains(&next) && !self.cache.contains_key(&next) {
+        if (lo..=hi).contains(&next) && !self.cache.contains_key(&next) {
             let (pattern, levels) = (self.pattern.clone(), self.levels);
-            let job = std::thread::spawn(move || Reader::load(&pattern, next, levels));
-            self.ahead = Some((next, job));
+            self.ahead
+                .start(next, move || Reader::load(&pattern, next, levels));
         }
         Ok(pyramid)
     }

@@ -81,25 +81,27 @@ trait Shrink: Send + Sync {
     fn evict_oldest(&self, keep: Option<&Key>) -> usize;
 }
 
-impl<T: Send + Sync> Shrink for Entries<T> {
-    fn oldest(&self, keep: Option<&Key>) -> Option<u64> {
-        let entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+impl<T> Entries<T> {
+    /// The index of the oldest finished entry other than `keep`.
+    fn oldest_of(entries: &[Entry<T>], keep: Option<&Key>) -> Option<usize> {
         entries
-            .iter()
-            .filter(|e| e.bytes > 0 && Some(&e.key) != keep)
-            .map(|e| e.last_use)
-            .min()
-    }
-
-    fn evict_oldest(&self, keep: Option<&Key>) -> usize {
-        let mut entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        let oldest = entries
             .iter()
             .enumerate()
             .filter(|(_, e)| e.bytes > 0 && Some(&e.key) != keep)
             .min_by_key(|(_, e)| e.last_use)
-            .map(|(i, _)| i);
-        match oldest {
+            .map(|(i, _)| i)
+    }
+}
+
+impl<T: Send + Sync> Shrink for Entries<T> {
+    fn oldest(&self, keep: Option<&Key>) -> Option<u64> {
+        let entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        Self::oldest_of(&entries, keep).map(|i| entries[i].last_use)
+    }
+
+    fn evict_oldest(&self, keep: Option<&Key>) -> usize {
+        let mut entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        match Self::oldest_of(&entries, keep) {
             Some(i) => entries.swap_remove(i).bytes,
             None => 0,
         }
