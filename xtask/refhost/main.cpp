@@ -366,6 +366,35 @@ void checkOverlayGl(Effect &fx, const Where &w) {
   }
 }
 
+/// Track Forward through the library, before any render: images fetched in
+/// instanceChanged, the progress suite, keys set at other times. The
+/// sources do not move from frame to frame, so B's line, which lies on
+/// Source B's checkerboard, must stay where it was keyed (a tracker that
+/// drifted, or keyed at the wrong scale, would move it). A's line lies on a
+/// plain ramp, where the tracker may rightly report it lost (a warning).
+void checkTrack(Effect &fx, const Where &w) {
+  auto *b = dynamic_cast<OFX::Host::Param::Double2DInstance *>(fx.getParam("line1_b_start"));
+  if (!b) return fail(w.text + ": no param line1_b_start");
+  double x0 = 0, y0 = 0;
+  b->get(0, x0, y0);
+  const OfxPointD scale = {1, 1};
+  expectOk(fx.beginInstanceChangedAction(kOfxChangeUserEdited), w, "beginInstanceChanged");
+  expectOk(fx.paramInstanceChangedAction("track_forward", kOfxChangeUserEdited, 0, scale), w,
+           "instanceChanged track_forward");
+  expectOk(fx.endInstanceChangedAction(kOfxChangeUserEdited), w, "endInstanceChanged");
+  for (double t : {3.0, 10.0}) {
+    double x = 0, y = 0;
+    if (b->get(t, x, y) != kOfxStatOK || std::fabs(x - x0) > 0.05 || std::fabs(y - y0) > 0.05) {
+      std::ostringstream m;
+      m << w.text << ": Track Forward moved line 1's B start from (" << x0 << ", " << y0
+        << ") to (" << x << ", " << y << ") at frame " << t << " of a still source";
+      fail(m.str());
+    }
+  }
+  // Back as keyLines left them, for the renders that follow.
+  keyLines(fx, w);
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -389,6 +418,7 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
   if (depth == std::string(kOfxBitDepthFloat)) {
     checkOverlay(*fx, w.with("overlay"));
     checkOverlayGl(*fx, w.with("overlay in OpenGL"));
+    if (inputClips(*fx).size() == 2) checkTrack(*fx, w.with("track"));
   }
 
   auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("method"));
