@@ -469,9 +469,10 @@ pub fn table_in_context(kind: NodeKind, context: &str) -> Vec<ParamSpec> {
 /// The transition context's mandated param (`kOfxImageEffectTransitionParamName`).
 pub const TRANSITION_PARAM: &str = "Transition";
 
-/// Param values at one time. A param the host cannot read keeps its
+/// Param values at one time. A param the host did not make keeps its
 /// default (minimal hosts), and is named in `missing` so it can be reported
-/// once.
+/// once; one the host made but cannot read is in `unreadable`, which fails
+/// the render (its value is the user's, and no default stands in for it).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     pub warp: MethodSettings,
@@ -487,6 +488,8 @@ pub struct Settings {
     pub edge: EdgeMode,
     pub view: View,
     pub missing: Vec<String>,
+    /// Why each param the host has could not be read.
+    pub unreadable: Vec<String>,
 }
 
 /// Reads params at one time, each by the table entry that defines it: the
@@ -498,6 +501,7 @@ pub struct Reader<'a> {
     kind: NodeKind,
     time: f64,
     missing: RefCell<Vec<String>>,
+    unreadable: RefCell<Vec<String>>,
 }
 
 impl<'a> Reader<'a> {
@@ -507,6 +511,7 @@ impl<'a> Reader<'a> {
             kind,
             time,
             missing: RefCell::new(Vec::new()),
+            unreadable: RefCell::new(Vec::new()),
         }
     }
 
@@ -515,13 +520,20 @@ impl<'a> Reader<'a> {
             .unwrap_or_else(|| panic!("param {id} is read but not in the node's table"))
     }
 
-    /// The host's value, or `None` (and `id` noted missing).
+    /// The host's value, or `None` (and `id` noted missing or unreadable).
     fn host<T>(&self, id: &str, read: impl FnOnce(&Params) -> Outcome<T>) -> Option<T> {
-        let value = read(self.params?).ok();
-        if value.is_none() {
-            self.missing.borrow_mut().push(id.to_owned());
+        let params = self.params?;
+        match read(params) {
+            Ok(v) => Some(v),
+            Err(why) if params.has(id) => {
+                self.unreadable.borrow_mut().push(why.message().to_owned());
+                None
+            }
+            Err(_) => {
+                self.missing.borrow_mut().push(id.to_owned());
+                None
+            }
         }
-        value
     }
 
     pub fn double(&self, id: &str) -> f64 {
@@ -602,6 +614,7 @@ impl Settings {
             kind,
             time: 0.0,
             missing: RefCell::new(Vec::new()),
+            unreadable: RefCell::new(Vec::new()),
         };
         Settings::read_with(reader, kind)
     }
@@ -644,9 +657,11 @@ impl Settings {
             edge: r.choice(EDGE),
             view: r.pick(VIEW, views(kind)),
             missing: Vec::new(),
+            unreadable: Vec::new(),
         };
         Settings {
             missing: r.missing.into_inner(),
+            unreadable: r.unreadable.into_inner(),
             ..settings
         }
     }

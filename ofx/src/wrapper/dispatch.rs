@@ -113,13 +113,8 @@ fn report(effect: Option<&Effect>, action: &CStr, failure: &Failure) {
     let effect = match effect {
         Some(effect) => effect,
         None => {
-            use std::io::Write;
-            let _ = writeln!(
-                std::io::stderr(),
-                "MorphFX: {}: {text}",
-                action.to_string_lossy()
-            );
-            return;
+            let text = format!("{}: {text}", action.to_string_lossy());
+            return super::host::unowned_error(id, &text);
         }
     };
     if RENDER_TIME.contains(&action) {

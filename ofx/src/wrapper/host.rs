@@ -86,10 +86,20 @@ pub fn load() -> Outcome {
             Ok(p)
         }
     };
-    let prop = required(kOfxPropertySuite, 1)? as *const OfxPropertySuiteV1;
-    let effect = required(kOfxImageEffectSuite, 1)? as *const OfxImageEffectSuiteV1;
-    let param = required(kOfxParameterSuite, 1)? as *const OfxParameterSuiteV1;
+    // The message suite first, so that a missing required suite is said
+    // through it (with no effect handle, which its v1 allows).
     let message = get(kOfxMessageSuite, 1) as *const OfxMessageSuiteV1;
+    MESSAGE.store(message as *mut OfxMessageSuiteV1, Ordering::Release);
+    let missing = |f: Failure| {
+        // A host that failed our load gets no use of suites fetched from a
+        // host before it.
+        *SUITES.write().unwrap_or_else(|e| e.into_inner()) = None;
+        f
+    };
+    let prop = required(kOfxPropertySuite, 1).map_err(missing)? as *const OfxPropertySuiteV1;
+    let effect =
+        required(kOfxImageEffectSuite, 1).map_err(missing)? as *const OfxImageEffectSuiteV1;
+    let param = required(kOfxParameterSuite, 1).map_err(missing)? as *const OfxParameterSuiteV1;
     let message_v2 = get(kOfxMessageSuite, 2) as *const OfxMessageSuiteV2;
     let interact = get(kOfxInteractSuite, 1) as *const OfxInteractSuiteV1;
     let draw = get(kOfxDrawSuite, 1) as *const OfxDrawSuiteV1;
@@ -112,6 +122,40 @@ pub fn load() -> Outcome {
     // A later load (a host that reloads us) replaces the suites.
     *SUITES.write().unwrap_or_else(|e| e.into_inner()) = Some(suites);
     Ok(())
+}
+
+/// The message suite of the last load, kept apart from [`SUITES`] so that a
+/// load failing for want of another suite can still say why.
+static MESSAGE: AtomicPtr<OfxMessageSuiteV1> = AtomicPtr::new(std::ptr::null_mut());
+
+/// Says `text` as an error with no effect to attach it to (an action sent
+/// with a null handle, a failed load): through the host's message suite,
+/// whose v1 takes a null handle, else on stderr.
+pub fn unowned_error(id: &CStr, text: &str) {
+    let suite = MESSAGE.load(Ordering::Acquire);
+    // SAFETY: null, or the suite the host returned for this name and
+    // version in our load action, valid while the binary is loaded.
+    let message = unsafe { suite.as_ref() }.and_then(|s| s.message);
+    let text = std::ffi::CString::new(text.replace('\0', " ")).unwrap_or_default();
+    let status = match message {
+        // SAFETY: the host's message function: a null handle (allowed by
+        // the v1 suite), a message type and id, and a "%s" format with one
+        // C string.
+        Some(f) => unsafe {
+            f(
+                std::ptr::null_mut(),
+                kOfxMessageError.as_ptr(),
+                id.as_ptr(),
+                c"%s".as_ptr(),
+                text.as_ptr(),
+            )
+        },
+        None => kOfxStatErrMissingHostFeature,
+    };
+    if status != kOfxStatOK {
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "MorphFX: {}", text.to_string_lossy());
+    }
 }
 
 /// The plugin's environment switches, read once (at the load action):

@@ -95,7 +95,32 @@ pub fn check(status: OfxStatus, what: &str) -> Outcome {
     } else {
         Err(Failure::Status(
             status,
-            format!("{what} failed with OFX status {status}"),
+            format!("{what} failed: the host answered {}", status_name(status)),
         ))
     }
+}
+
+/// A status as the spec names it, so a message read by a host's support
+/// staff says what the host answered without a header to hand.
+#[allow(non_upper_case_globals)] // the spec's names, matched as constants
+pub fn status_name(status: OfxStatus) -> String {
+    let name = match status {
+        kOfxStatOK => "kOfxStatOK",
+        kOfxStatFailed => "kOfxStatFailed",
+        kOfxStatErrFatal => "kOfxStatErrFatal",
+        kOfxStatErrUnknown => "kOfxStatErrUnknown",
+        kOfxStatErrMissingHostFeature => "kOfxStatErrMissingHostFeature",
+        kOfxStatErrUnsupported => "kOfxStatErrUnsupported",
+        kOfxStatErrExists => "kOfxStatErrExists",
+        kOfxStatErrFormat => "kOfxStatErrFormat",
+        kOfxStatErrMemory => "kOfxStatErrMemory",
+        kOfxStatErrBadHandle => "kOfxStatErrBadHandle",
+        kOfxStatErrBadIndex => "kOfxStatErrBadIndex",
+        kOfxStatErrValue => "kOfxStatErrValue",
+        kOfxStatReplyYes => "kOfxStatReplyYes",
+        kOfxStatReplyNo => "kOfxStatReplyNo",
+        kOfxStatReplyDefault => "kOfxStatReplyDefault",
+        _ => return format!("status {status}"),
+    };
+    format!("{name} ({status})")
 }

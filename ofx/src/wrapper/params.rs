@@ -234,6 +234,12 @@ unsafe impl Send for Params {}
 unsafe impl Sync for Params {}
 
 impl Params {
+    /// Whether the host made param `id` (a minimal host may not make every
+    /// kind the plugin defines).
+    pub fn has(&self, id: &str) -> bool {
+        self.handles.contains_key(id)
+    }
+
     fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
         self.handles.get(id).copied().ok_or_else(|| {
             Failure::Status(

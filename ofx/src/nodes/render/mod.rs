@@ -219,6 +219,12 @@ fn read_settings(
     time: f64,
 ) -> Outcome<Settings> {
     let settings = Settings::read(instance.params()?, time, kind);
+    if let Some(first) = settings.unreadable.first() {
+        return Err(Failure::Failed(format!(
+            "the host could not give {} of this node's params at frame {time}: {first}",
+            settings.unreadable.len()
+        )));
+    }
     if !settings.missing.is_empty() && instance.first_time("missing params") {
         effect.message(
             kOfxMessageWarning,
