@@ -376,6 +376,9 @@ unsafe extern "C" fn clip_get_image(
         if image.is_null() {
             return kOfxStatErrBadHandle;
         }
+        if super::misuse::no_image(&c.name) {
+            return kOfxStatFailed;
+        }
         let frame = match c.frame_at(time) {
             Ok(Some(f)) => f,
             Ok(None) => return kOfxStatFailed,
@@ -398,6 +401,7 @@ unsafe extern "C" fn clip_get_image(
             .lock()
             .unwrap_or_else(|e| e.into_inner());
         let props = frame.image_props(scale, time);
+        super::misuse::tamper_image(&c.name, &props);
         // SAFETY: out-pointer from the plugin. The boxed set (owning the frame) is
         // released by clipReleaseImage.
         unsafe { *image = Box::into_raw(Box::new(props)) as OfxPropertySetHandle };
@@ -533,6 +537,16 @@ unsafe fn message_of(kind: *const c_char, id: *const c_char, text: *const c_char
     }
 }
 
+/// Messages posted with no effect handle (the message suite v1 allows it),
+/// the first [`UNOWNED_KEPT`] until taken.
+static UNOWNED: Mutex<Vec<Message>> = Mutex::new(Vec::new());
+const UNOWNED_KEPT: usize = 256;
+
+/// Takes the messages the plugin posted with no effect handle.
+pub fn take_unowned_messages() -> Vec<Message> {
+    std::mem::take(&mut *UNOWNED.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
 /// # Safety
 /// Called by the C shim with the plugin's handle (checked against live effects) and C strings.
 #[unsafe(no_mangle)]
@@ -547,7 +561,13 @@ pub unsafe extern "C" fn mfx_message_text(
         let m = unsafe { message_of(kind, id, text) };
         match live_effect(handle) {
             Some(e) => e.messages.lock().unwrap_or_else(|e| e.into_inner()).push(m),
-            None => eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text),
+            None => {
+                eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text);
+                let mut unowned = UNOWNED.lock().unwrap_or_else(|e| e.into_inner());
+                if unowned.len() < UNOWNED_KEPT {
+                    unowned.push(m);
+                }
+            }
         }
         kOfxStatOK
     })

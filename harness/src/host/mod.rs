@@ -6,6 +6,7 @@ pub mod allocator;
 pub mod effect;
 pub mod frame;
 pub mod guard;
+pub mod misuse;
 pub mod overlay;
 pub mod params;
 pub mod props;
@@ -26,7 +27,7 @@ use openfx::sys::image_effect_v1::param::*;
 use openfx::sys::image_effect_v1::progress::kOfxProgressSuite;
 use openfx::sys::image_effect_v1::time_line::kOfxTimeLineSuite;
 
-pub use effect::{Effect, FrameSource, Message};
+pub use effect::{take_unowned_messages, Effect, FrameSource, Message};
 pub use frame::Frame;
 use params::ParamValue;
 use props::PropertySet;
@@ -134,6 +135,9 @@ unsafe extern "C" fn fetch_suite(
         }
         // SAFETY: suite names are NUL-terminated C strings.
         let name = unsafe { CStr::from_ptr(name) };
+        if misuse::withholds(name) {
+            return std::ptr::null();
+        }
         let loaded = LOADED_HOSTS
             .lock()
             .unwrap_or_else(|e| e.into_inner())
@@ -835,6 +839,37 @@ impl Instance<'_> {
         } else {
             Err(failure(st, &action.to_string_lossy(), Some(&self.effect)))
         }
+    }
+
+    /// Sends `action` as a misbehaving host might (tests of the plugin's
+    /// answers): with no effect handle when `null_handle`, and the
+    /// arguments as given. The plugin's status, as it answered, and the
+    /// messages it posted on the instance (its persistent one taken too).
+    pub fn send_raw(
+        &self,
+        action: &CStr,
+        null_handle: bool,
+        in_args: Option<&PropertySet>,
+        out_args: Option<&PropertySet>,
+    ) -> (OfxStatus, Vec<Message>) {
+        let handle = if null_handle {
+            std::ptr::null()
+        } else {
+            self.effect.handle() as *const c_void
+        };
+        self.effect.take_messages();
+        let status = self
+            .bundle
+            .call(self.plugin, action, handle, in_args, out_args);
+        let mut messages = self.effect.take_messages();
+        messages.extend(
+            self.effect
+                .persistent
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take(),
+        );
+        (status, messages)
     }
 
     fn sequence_args(first: f64, last: f64) -> PropertySet {

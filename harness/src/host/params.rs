@@ -343,6 +343,9 @@ unsafe extern "C" fn delete_all_keys(h: OfxParamHandle) -> OfxStatus {
         let Some(p) = (unsafe { param_of(h) }) else {
             return kOfxStatErrBadHandle;
         };
+        if super::misuse::params_unreadable() {
+            return kOfxStatErrUnknown;
+        }
         let v = p.value_at(0.0);
         p.set(v);
         kOfxStatOK
@@ -502,6 +505,9 @@ pub unsafe extern "C" fn mfx_param_get(
         let Some(p) = (unsafe { param_of(h) }) else {
             return kOfxStatErrBadHandle;
         };
+        if super::misuse::params_unreadable() {
+            return kOfxStatErrUnknown;
+        }
         let v = p.value_at(if at_time != 0 { time } else { 0.0 });
         // SAFETY: the shim's arrays hold 4 values; the string pointer stays valid
         // because the param keeps an equal CString until it is set again — we

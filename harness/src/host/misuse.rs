@@ -1,0 +1,84 @@
+//! Ways this host can be made to misbehave as hosts in the field do, so that
+//! tests can hold the plugin to its answer for each: a clear failure status
+//! and a message, never a crash. Nothing here is armed in normal use.
+//!
+//! What is armed holds for the whole process (the plugin has one host), so
+//! [`arm`] also serialises the tests that use it: it waits for the previous
+//! arming to be dropped.
+
+use std::ffi::CStr;
+use std::sync::{Mutex, MutexGuard};
+
+use super::props::PropertySet;
+
+/// One kind of misbehaviour.
+#[derive(Clone, Copy)]
+pub enum Misuse {
+    /// `fetchSuite` answers null for this suite, whatever the version.
+    WithholdSuite(&'static CStr),
+    /// `clipGetImage` on this clip fails (`kOfxStatFailed`) with no message
+    /// of the host's own.
+    NoImage(&'static str),
+    /// Every image `clipGetImage` hands out for this clip has its
+    /// properties passed through this function first.
+    TamperImage(&'static str, fn(&PropertySet)),
+    /// `paramGetValue` and `paramGetValueAtTime` answer `kOfxStatErrUnknown`.
+    UnreadableParams,
+}
+
+static ARMED: Mutex<Vec<Misuse>> = Mutex::new(Vec::new());
+static SERIAL: Mutex<()> = Mutex::new(());
+
+/// Misuses in force until dropped.
+pub struct Armed {
+    _serial: MutexGuard<'static, ()>,
+}
+
+impl Drop for Armed {
+    fn drop(&mut self) {
+        armed().clear();
+    }
+}
+
+/// Arms `misuses` (none: a well-behaved host, still serialised with the
+/// tests that arm some) until the returned value is dropped.
+pub fn arm(misuses: &[Misuse]) -> Armed {
+    let serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    *armed() = misuses.to_vec();
+    Armed { _serial: serial }
+}
+
+fn armed() -> MutexGuard<'static, Vec<Misuse>> {
+    ARMED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+pub(crate) fn withholds(suite: &CStr) -> bool {
+    armed()
+        .iter()
+        .any(|m| matches!(m, Misuse::WithholdSuite(s) if *s == suite))
+}
+
+pub(crate) fn no_image(clip: &str) -> bool {
+    armed()
+        .iter()
+        .any(|m| matches!(m, Misuse::NoImage(c) if *c == clip))
+}
+
+pub(crate) fn tamper_image(clip: &str, props: &PropertySet) {
+    let tampers: Vec<fn(&PropertySet)> = armed()
+        .iter()
+        .filter_map(|m| match m {
+            Misuse::TamperImage(c, f) if *c == clip => Some(*f),
+            _ => None,
+        })
+        .collect();
+    for f in tampers {
+        f(props);
+    }
+}
+
+pub(crate) fn params_unreadable() -> bool {
+    armed()
+        .iter()
+        .any(|m| matches!(m, Misuse::UnreadableParams))
+}
