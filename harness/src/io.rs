@@ -188,8 +188,8 @@ fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
             compression: None,
         });
     }
-    let meta = exr::meta::MetaData::read_from_file(path, false)
-        .map_err(|e| HostError::bad(format!("{}: cannot read EXR: {e}", path.display())))?;
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| exr_read_error(path, e))?;
     let header = meta
         .headers
         .first()
@@ -231,6 +231,28 @@ fn data_bounds(
     )
 }
 
+/// What went wrong reading an EXR, in words a user can act on (the exr
+/// crate's own say "reference to missing bytes" for a cut-short file).
+fn exr_read_error(path: &Path, e: exr::error::Error) -> HostError {
+    use exr::error::Error;
+    use std::io::ErrorKind;
+    let what = match e {
+        Error::Invalid(m) if m.contains("missing bytes") => {
+            "the file ends before its header or pixels do: it is truncated".to_string()
+        }
+        Error::Io(io) if io.kind() == ErrorKind::UnexpectedEof => {
+            "the file ends before its header or pixels do: it is truncated".to_string()
+        }
+        Error::Invalid(m) => format!("the file is corrupt: {m}"),
+        Error::Io(io) if io.kind() == ErrorKind::InvalidInput => {
+            format!("the file is corrupt: an offset in it points outside it ({io})")
+        }
+        Error::NotSupported(m) => format!("it uses what morphfx cannot read: {m}"),
+        other => other.to_string(),
+    };
+    HostError::bad(format!("{}: cannot read EXR: {what}", path.display()))
+}
+
 fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
     probe(path)?;
     let img = exr::prelude::read()
@@ -240,7 +262,7 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| HostError::bad(format!("{}: cannot read EXR: {e}", path.display())))?;
+        .map_err(|e| exr_read_error(path, e))?;
     let display = img.attributes.display_window;
     let layer = &img.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
