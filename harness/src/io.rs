@@ -424,33 +424,39 @@ pub fn write_as(
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)
-        .map_err(|e| HostError::bad(format!("{}: cannot create folder: {e}", dir.display())))?;
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
-    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let result = match ext.as_str() {
-        "exr" => write_exr(&tmp, plate, format),
-        "png" | "tif" | "tiff" | "jpg" | "jpeg" => write_other(&tmp, plate, &ext, format.colour),
-        _ => Err(HostError::bad(format!(
+    if !matches!(
+        ext.as_str(),
+        "exr" | "png" | "tif" | "tiff" | "jpg" | "jpeg"
+    ) {
+        return Err(HostError::bad(format!(
             "{}: unknown output format (use .exr or .png)",
             path.display()
-        ))),
-    };
-    match result.and_then(|_| {
-        std::fs::rename(&tmp, path)
-            .map_err(|e| HostError::failed(format!("{}: {e}", path.display())))
-    }) {
-        Ok(()) => Ok(()),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
+        )));
     }
+    std::fs::create_dir_all(dir)
+        .map_err(|e| HostError::bad(format!("{}: cannot create folder: {e}", dir.display())))?;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    let result = match ext.as_str() {
+        "exr" => write_exr(&tmp, plate, format),
+        _ => write_other(&tmp, plate, &ext, format.colour),
+    };
+    let result = result.and_then(|_| {
+        std::fs::rename(&tmp, path).map_err(|e| HostError::bad(format!("{}: {e}", tmp.display())))
+    });
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        // Said of the name the user asked for (the temporary one means
+        // nothing to them); whatever stood under it before stands still.
+        let prefix = format!("{}: ", tmp.display());
+        let cause = e.message.strip_prefix(&prefix).unwrap_or(&e.message);
+        HostError::bad(format!("{}: not written: {cause}", path.display()))
+    })
 }
 
 fn rgba_at(plate: &Plate, x: usize, row_from_top: usize) -> [f32; 4] {

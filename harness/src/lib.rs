@@ -3,6 +3,7 @@
 
 pub mod exr_zip;
 pub mod host;
+pub mod interrupt;
 pub mod io;
 pub mod pipeline;
 pub mod progress;

@@ -15,6 +15,7 @@ use morphfx_harness::host::overlay::Overlay;
 use morphfx_harness::host::{
     Bundle, ErrorKind, Frame, FrameSource, HostError, HostOptions, Instance, OutputSpec,
 };
+use morphfx_harness::interrupt;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
 use morphfx_harness::pipeline::{ReadAhead, WriteBehind};
 use morphfx_harness::progress::Progress;
@@ -239,6 +240,7 @@ enum Command {
 fn main() {
     morphfx_harness::host::allocator::tune_for_frames();
     let cli = Cli::parse();
+    interrupt::install();
     if cli.verbose {
         // The plugin is told through its environment (set before it is
         // loaded; nothing else runs yet): it prints what it measures to stderr.
@@ -248,7 +250,11 @@ fn main() {
         Ok(()) => {}
         Err(e) => {
             eprintln!("morphfx: error: {}", e.message);
-            std::process::exit(if e.kind == ErrorKind::BadInput { 2 } else { 1 });
+            std::process::exit(match e.kind {
+                ErrorKind::BadInput => 2,
+                ErrorKind::Failed => 1,
+                ErrorKind::Interrupted => interrupt::EXIT_STATUS,
+            });
         }
     }
 }
@@ -848,6 +854,9 @@ impl Job {
         // Frame n is written while frame n + 1 renders.
         let writer = WriteBehind::new(0);
         for (n, &f) in frames.iter().enumerate() {
+            if interrupt::requested() {
+                return Err(interrupted(writer, &frames[..n]));
+            }
             if transition {
                 // The host drives the context's mandated Transition param, as
                 // an editor does from where the frame sits in the transition.
@@ -872,7 +881,12 @@ impl Job {
                     ..OutputSpec::default()
                 };
                 let started = Instant::now();
-                let out = inst.render(f as f64, spec).map_err(read_error)?;
+                let out = inst.render(f as f64, spec);
+                if interrupt::requested() {
+                    // Its picture may be unfinished (the render was told to abort).
+                    return Err(interrupted(writer, &frames[..n]));
+                }
+                let out = out.map_err(read_error)?;
                 rendering += started.elapsed();
                 let plate = Plate {
                     image: out.into_image(),
@@ -901,6 +915,21 @@ impl Job {
             writing.as_secs_f64()
         ));
         Ok(())
+    }
+}
+
+/// The run stopped by a signal once the frames `done` are written whole:
+/// the error that says which frames are on disk.
+fn interrupted(writer: WriteBehind, done: &[i64]) -> HostError {
+    if let Err(e) = writer.finish() {
+        return e;
+    }
+    match (done.first(), done.last()) {
+        (Some(first), Some(last)) => HostError::interrupted(format!(
+            "interrupted: {} frame(s) written whole, {first} to {last}; no later frame was written",
+            done.len()
+        )),
+        _ => HostError::interrupted("interrupted before any frame was written"),
     }
 }
 

@@ -107,7 +107,10 @@ impl Frames<HostError> for Reader {
 impl From<morphfx::Error> for HostError {
     fn from(e: morphfx::Error) -> Self {
         match e {
-            morphfx::Error::Cancelled => HostError::failed("cancelled"),
+            // Only Ctrl-C or SIGTERM cancels a track here.
+            morphfx::Error::Cancelled => HostError::interrupted(
+                "interrupted before tracking finished: the scene was not written",
+            ),
             e => HostError::bad(e.to_string()),
         }
     }
@@ -158,7 +161,7 @@ impl Track<'_> {
                 &self.settings,
                 &mut |done, _, frame| {
                     progress.tick(done_before + done, frame);
-                    true
+                    !crate::interrupt::requested()
                 },
             )?;
             done_before += per_side;

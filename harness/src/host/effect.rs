@@ -475,8 +475,9 @@ unsafe extern "C" fn clip_get_rod(
     })
 }
 
+/// A render the user interrupted may stop early: its picture is dropped.
 unsafe extern "C" fn abort(_: OfxImageEffectHandle) -> c_int {
-    super::guard::guard(0, "abort", || 0)
+    super::guard::guard(0, "abort", || crate::interrupt::requested() as c_int)
 }
 
 unsafe extern "C" fn memory_alloc(

@@ -41,6 +41,8 @@ pub enum ErrorKind {
     BadInput,
     /// Exit status 1.
     Failed,
+    /// Stopped by Ctrl-C or SIGTERM ([`crate::interrupt`]).
+    Interrupted,
 }
 
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -59,6 +61,12 @@ impl HostError {
     pub fn failed(m: impl Into<String>) -> Self {
         HostError {
             kind: ErrorKind::Failed,
+            message: m.into(),
+        }
+    }
+    pub fn interrupted(m: impl Into<String>) -> Self {
+        HostError {
+            kind: ErrorKind::Interrupted,
             message: m.into(),
         }
     }
