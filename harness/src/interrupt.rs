@@ -1,14 +1,16 @@
 //! Ctrl-C and SIGTERM (how farm managers stop a job): the frame being
 //! rendered is dropped, the frames already rendered finish writing, and
-//! `morphfx` says which frames are complete and exits with status 130,
-//! leaving no partial file under any name. A second signal stops at once.
+//! `morphfx` names the first frame not written, says which are complete and
+//! exits with status 2 (the contract's statuses are 0, 2 and 1), leaving no
+//! partial file under any name. A second signal stops at once.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
 
-/// The exit status of an interrupted run (128 + SIGINT, as shells report it).
-pub const EXIT_STATUS: i32 = 130;
+/// The exit status of a run stopped by a second signal, before its
+/// message could be made (the first gives the usual 2).
+pub const EXIT_STATUS: i32 = 2;
 
 /// Handles SIGINT and SIGTERM from now on. A failure to install (another
 /// handler owns them) leaves the default: the process dies, and outputs

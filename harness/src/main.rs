@@ -251,9 +251,8 @@ fn main() {
         Err(e) => {
             eprintln!("morphfx: error: {}", e.message);
             std::process::exit(match e.kind {
-                ErrorKind::BadInput => 2,
+                ErrorKind::BadInput | ErrorKind::Interrupted => 2,
                 ErrorKind::Failed => 1,
-                ErrorKind::Interrupted => interrupt::EXIT_STATUS,
             });
         }
     }
@@ -855,7 +854,7 @@ impl Job {
         let writer = WriteBehind::new(0);
         for (n, &f) in frames.iter().enumerate() {
             if interrupt::requested() {
-                return Err(interrupted(writer, &frames[..n]));
+                return Err(interrupted(writer, &frames[..n], frame_path(&c.output, f)));
             }
             if transition {
                 // The host drives the context's mandated Transition param, as
@@ -884,7 +883,7 @@ impl Job {
                 let out = inst.render(f as f64, spec);
                 if interrupt::requested() {
                     // Its picture may be unfinished (the render was told to abort).
-                    return Err(interrupted(writer, &frames[..n]));
+                    return Err(interrupted(writer, &frames[..n], frame_path(pattern, f)));
                 }
                 let out = out.map_err(read_error)?;
                 rendering += started.elapsed();
@@ -918,19 +917,22 @@ impl Job {
     }
 }
 
-/// The run stopped by a signal once the frames `done` are written whole:
-/// the error that says which frames are on disk.
-fn interrupted(writer: WriteBehind, done: &[i64]) -> HostError {
+/// The run stopped by a signal before `missing` was written, once the
+/// frames `done` are written whole: the error that says what is on disk.
+fn interrupted(writer: WriteBehind, done: &[i64], missing: PathBuf) -> HostError {
     if let Err(e) = writer.finish() {
         return e;
     }
-    match (done.first(), done.last()) {
-        (Some(first), Some(last)) => HostError::interrupted(format!(
-            "interrupted: {} frame(s) written whole, {first} to {last}; no later frame was written",
-            done.len()
-        )),
-        _ => HostError::interrupted("interrupted before any frame was written"),
-    }
+    let whole = match (done.first(), done.last()) {
+        (Some(first), Some(last)) => {
+            format!("{} frame(s) written whole, {first} to {last}", done.len())
+        }
+        _ => "no frame written".to_owned(),
+    };
+    HostError::interrupted(format!(
+        "{}: not written: interrupted; {whole}, none after",
+        missing.display()
+    ))
 }
 
 /// The scene file, parsed, if one is given.

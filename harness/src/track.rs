@@ -108,9 +108,9 @@ impl From<morphfx::Error> for HostError {
     fn from(e: morphfx::Error) -> Self {
         match e {
             // Only Ctrl-C or SIGTERM cancels a track here.
-            morphfx::Error::Cancelled => HostError::interrupted(
-                "interrupted before tracking finished: the scene was not written",
-            ),
+            morphfx::Error::Cancelled => {
+                HostError::interrupted("interrupted before tracking finished: nothing was written")
+            }
             e => HostError::bad(e.to_string()),
         }
     }

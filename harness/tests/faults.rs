@@ -1,7 +1,7 @@
 //! Interruption and disk faults: Ctrl-C or SIGTERM, a full disk and an
 //! unwritable folder never leave a partial or corrupt frame under a final
-//! name; the run says which file failed (exit 2) or which frames are whole
-//! (interrupted: exit 130).
+//! name; the run names the file it could not write and exits 2 (an
+//! interrupted one also says which frames are whole).
 
 mod common;
 
@@ -182,16 +182,20 @@ fn an_interrupted_run_leaves_only_whole_frames_and_says_which() {
         let status = child.wait().unwrap();
         let mut err = String::new();
         std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
-        assert_eq!(status.code(), Some(130), "{signal}: {err}");
-        // "morphfx: error: interrupted: N frame(s) written whole, 1 to N; ..."
+        assert_eq!(status.code(), Some(2), "{signal}: {err}");
+        // "morphfx: error: out/m.{N+1}.exr: not written: interrupted; N frame(s) written whole, 1 to N, none after"
         let n: usize = err
-            .split("error: interrupted: ")
+            .split("interrupted; ")
             .nth(1)
             .and_then(|s| s.split_whitespace().next())
             .and_then(|n| n.parse().ok())
             .unwrap_or_else(|| panic!("{signal}: no count of frames written: {err}"));
         assert!((3..1000).contains(&n), "{signal}: {n} frames: {err}");
-        assert!(err.contains(&format!("1 to {n};")), "{signal}: {err}");
+        assert!(
+            err.contains(&format!("out/m.{:04}.exr: not written", n + 1))
+                && err.contains(&format!("1 to {n}, none after")),
+            "{signal}: {err}"
+        );
         let expected: Vec<String> = (1..=n).map(|f| format!("m.{f:04}.exr")).collect();
         assert_eq!(names(&d.join("out")), expected, "{signal}");
         for name in &expected {
