@@ -59,10 +59,11 @@ fn use_layout(inst: &Instance<'_>, k: usize) {
     }
 }
 
-/// Methods whose result depends on the request alone (`thin-plate` and
-/// `auto` start from the last frame they solved, so theirs depends on the
-/// order of renders too, within their tolerance).
-const METHODS: [&str; 3] = ["field", "triangles", "mffd"];
+/// Every method lines alone can drive (a mesh needs a scene's meshes).
+/// `thin-plate` and `auto` start from the frame before only in a sequential
+/// render, which this random-access host never asks for: here, too, the
+/// result depends on the request alone.
+const METHODS: [&str; 6] = ["field", "triangles", "mffd", "thin-plate", "hybrid", "auto"];
 
 /// One request: method, layout, time (progress follows it), render scale.
 type Request = (usize, usize, u32, u32);

@@ -96,9 +96,14 @@ fn arch_folders() -> &'static [&'static str] {
 /// baseline build as `MorphFX.ofx` and, on x86-64, the x86-64-v3 build beside
 /// it, which the baseline build hands over to on CPUs with AVX2 and FMA.
 fn bundle(release: bool) -> PathBuf {
+    bundle_in(release, "bundle")
+}
+
+/// [`bundle`], laid out under `target/FOLDER`.
+fn bundle_in(release: bool, folder: &str) -> PathBuf {
     let baseline = build_plugin(release, false);
     let fast = cfg!(target_arch = "x86_64").then(|| build_plugin(release, true));
-    let bundle = target_dir().join("bundle").join("MorphFX.ofx.bundle");
+    let bundle = target_dir().join(folder).join("MorphFX.ofx.bundle");
     for arch in arch_folders() {
         let bin_dir = bundle.join("Contents").join(arch);
         std::fs::create_dir_all(&bin_dir).expect("create bundle folders");
@@ -149,6 +154,7 @@ fn main() {
             let mut run = vec!["test", "--workspace"];
             run.extend(args[1..].iter().map(String::as_str));
             cargo(&run);
+            release_concurrency(&b);
             docs();
             refhost::check(&b);
             cmake_install_check();
@@ -160,6 +166,24 @@ fn main() {
             exit(2);
         }
     }
+}
+
+/// The concurrency test again with the plugin and the test built in the
+/// release profile: optimised code reorders and inlines more, and has no
+/// overflow checks, so races and arithmetic it hides in a debug build show
+/// here.
+fn release_concurrency(dev_bundle: &Path) {
+    let b = bundle_in(true, "bundle-release");
+    unsafe_env("MORPHFX_BUNDLE", &b);
+    cargo(&[
+        "test",
+        "--release",
+        "--package",
+        "morphfx-harness",
+        "--test",
+        "concurrency",
+    ]);
+    unsafe_env("MORPHFX_BUNDLE", dev_bundle);
 }
 
 /// `cargo doc --no-deps` with rustdoc's warnings denied: a broken link or
