@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use exr::prelude::*;
+use half::slice::HalfFloatSliceExt;
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 use rayon::prelude::*;
@@ -295,30 +296,33 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
         .iter()
         .map(|pick| pick.map(|k| &list[k].sample_data))
         .collect();
-    // Rows in parallel: the file's rows run top-down, ours bottom-up.
+    // Rows in parallel: the file's rows run top-down, ours bottom-up. A
+    // channel's row is made floats in one slice conversion (F16C for
+    // halves), then spread into the pixels.
     image
         .data
         .par_chunks_mut((w * 4).max(1))
         .enumerate()
-        .for_each(|(j, out)| {
-            let first = (h - 1 - j) * w;
-            for (c, source) in sources.iter().enumerate() {
-                // This channel's sample of each pixel of the row.
-                let dst = out.iter_mut().skip(c).step_by(4);
-                match source {
-                    Some(FlatSamples::F16(v)) => dst
-                        .zip(&v[first..first + w])
-                        .for_each(|(d, s)| *d = s.to_f32()),
-                    Some(FlatSamples::F32(v)) => {
-                        dst.zip(&v[first..first + w]).for_each(|(d, s)| *d = *s)
+        .for_each_init(
+            || vec![0f32; w],
+            |lane, (j, out)| {
+                let first = (h - 1 - j) * w;
+                for (c, source) in sources.iter().enumerate() {
+                    match source {
+                        Some(FlatSamples::F16(v)) => v[first..first + w].convert_to_f32_slice(lane),
+                        Some(FlatSamples::F32(v)) => lane.copy_from_slice(&v[first..first + w]),
+                        Some(FlatSamples::U32(v)) => lane
+                            .iter_mut()
+                            .zip(&v[first..first + w])
+                            .for_each(|(d, s)| *d = *s as f32),
+                        None => lane.fill(1.0),
                     }
-                    Some(FlatSamples::U32(v)) => dst
-                        .zip(&v[first..first + w])
-                        .for_each(|(d, s)| *d = *s as f32),
-                    None => dst.for_each(|d| *d = 1.0),
+                    for (px, s) in out.chunks_exact_mut(4).zip(lane.iter()) {
+                        px[c] = *s;
+                    }
                 }
-            }
-        });
+            },
+        );
     Ok(Plate {
         image,
         size: (display.size.width(), display.size.height()),
