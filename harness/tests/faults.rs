@@ -58,6 +58,28 @@ fn morphfx_in(dir: &Path, setup: &str, args: &[&str]) -> Command {
     c
 }
 
+/// `morphfx morph` of sequence `a.####.exr` with itself over `frames`
+/// into `out/m.####.exr`, in `dir`, after `setup`.
+fn morph_into_out(dir: &Path, setup: &str, frames: &str) -> Command {
+    morphfx_in(
+        dir,
+        setup,
+        &[
+            "morph",
+            "--scene",
+            "s.morph.json",
+            "--a",
+            "a.####.exr",
+            "--b",
+            "a.####.exr",
+            "--frames",
+            frames,
+            "-o",
+            "out/m.####.exr",
+        ],
+    )
+}
+
 #[test]
 fn a_full_disk_stops_at_the_frame_it_cannot_hold_and_names_it() {
     let d = common::scratch("full-disk");
@@ -70,25 +92,9 @@ fn a_full_disk_stops_at_the_frame_it_cannot_hold_and_names_it() {
     // Files beyond 64 blocks of 512 bytes cannot be written: the process
     // sees the error a full disk gives, mid-file (SIGXFSZ ignored, so the
     // write fails instead of the process dying).
-    let out = morphfx_in(
-        &d,
-        "trap '' XFSZ; ulimit -f 64",
-        &[
-            "morph",
-            "--scene",
-            "s.morph.json",
-            "--a",
-            "a.####.exr",
-            "--b",
-            "a.####.exr",
-            "--frames",
-            "1-4",
-            "-o",
-            "out/m.####.exr",
-        ],
-    )
-    .output()
-    .unwrap();
+    let out = morph_into_out(&d, "trap '' XFSZ; ulimit -f 64", "1-4")
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
@@ -147,27 +153,11 @@ fn an_interrupted_run_leaves_only_whole_frames_and_says_which() {
             std::os::unix::fs::symlink(d.join("a.exr"), d.join(format!("a.{f:04}.exr"))).unwrap();
         }
         std::fs::create_dir(d.join("out")).unwrap();
-        let mut child = morphfx_in(
-            &d,
-            "true",
-            &[
-                "morph",
-                "--scene",
-                "s.morph.json",
-                "--a",
-                "a.####.exr",
-                "--b",
-                "a.####.exr",
-                "--frames",
-                "1-1000",
-                "-o",
-                "out/m.####.exr",
-            ],
-        )
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+        let mut child = morph_into_out(&d, "true", "1-1000")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
         // Interrupt it once a few frames are down, mid-shot.
         let start = Instant::now();
         while !d.join("out/m.0003.exr").exists() {
