@@ -25,7 +25,8 @@ const ZIPS: u8 = 2;
 const ZIP: u8 = 3;
 
 /// Writes `plate` as RGBA at `precision`, ZIP-compressed in blocks of
-/// `lines` scan lines (1: ZIPS, 16: ZIP).
+/// `lines` scan lines (1: ZIPS, 16: ZIP). An error says what failed; the
+/// caller names the file (`io::write_as`, which writes a temporary one).
 pub fn write(
     path: &Path,
     plate: &Plate,
@@ -67,8 +68,7 @@ pub fn write(
             },
         )
         .collect();
-    let err =
-        |e: std::io::Error| HostError::failed(format!("{}: cannot write EXR: {e}", path.display()));
+    let err = |e: std::io::Error| HostError::failed(format!("cannot write EXR: {e}"));
     let mut file = std::io::BufWriter::new(std::fs::File::create(path).map_err(err)?);
     file.write_all(&header).map_err(err)?;
     // The offset table: where each block starts in the file.

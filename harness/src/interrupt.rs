@@ -8,10 +8,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
 
-/// The exit status of a run stopped by a second signal, before its
-/// message could be made (the first gives the usual 2).
-pub const EXIT_STATUS: i32 = 2;
-
 /// Handles SIGINT and SIGTERM from now on. A failure to install (another
 /// handler owns them) leaves the default: the process dies, and outputs
 /// still never stand half-written under their final names.
@@ -19,7 +15,8 @@ pub fn install() {
     let _ = ctrlc::set_handler(|| {
         if SIGNALS.fetch_add(1, Ordering::SeqCst) > 0 {
             eprintln!("morphfx: interrupted again: stopping now");
-            std::process::exit(EXIT_STATUS);
+            // The status the first signal's message would have ended with.
+            std::process::exit(2);
         }
         eprintln!("morphfx: interrupted: finishing the frames already rendered");
     });

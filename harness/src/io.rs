@@ -237,11 +237,13 @@ fn data_bounds(
 fn exr_read_error(path: &Path, e: exr::error::Error) -> HostError {
     use exr::error::Error;
     use std::io::ErrorKind;
+    let truncated = match &e {
+        Error::Invalid(m) => m.contains("missing bytes"),
+        Error::Io(io) => io.kind() == ErrorKind::UnexpectedEof,
+        _ => false,
+    };
     let what = match e {
-        Error::Invalid(m) if m.contains("missing bytes") => {
-            "the file ends before its header or pixels do: it is truncated".to_string()
-        }
-        Error::Io(io) if io.kind() == ErrorKind::UnexpectedEof => {
+        _ if truncated => {
             "the file ends before its header or pixels do: it is truncated".to_string()
         }
         Error::Invalid(m) => format!("the file is corrupt: {m}"),
@@ -451,15 +453,18 @@ pub fn write_as(
         _ => write_other(&tmp, plate, &ext, format.colour),
     };
     let result = result.and_then(|_| {
-        std::fs::rename(&tmp, path).map_err(|e| HostError::bad(format!("{}: {e}", tmp.display())))
+        std::fs::rename(&tmp, path)
+            .map_err(|e| HostError::failed(format!("cannot rename it into place: {e}")))
     });
-    result.map_err(|e| {
+    result.map_err(|cause| {
         let _ = std::fs::remove_file(&tmp);
         // Said of the name the user asked for (the temporary one means
         // nothing to them); whatever stood under it before stands still.
-        let prefix = format!("{}: ", tmp.display());
-        let cause = e.message.strip_prefix(&prefix).unwrap_or(&e.message);
-        HostError::bad(format!("{}: not written: {cause}", path.display()))
+        HostError::bad(format!(
+            "{}: not written: {}",
+            path.display(),
+            cause.message
+        ))
     })
 }
 
@@ -502,9 +507,7 @@ fn write_exr(
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
-    let err = |e: exr::error::Error| {
-        HostError::failed(format!("{}: cannot write EXR: {e}", path.display()))
-    };
+    let err = |e: exr::error::Error| HostError::failed(format!("cannot write EXR: {e}"));
     let (ox, oy) = plate.origin;
     let position = Vec2(ox + b.x1, oy + dh - b.y2);
     let display = IntegerBounds::new(Vec2(ox, oy), Vec2(plate.size.0, plate.size.1));
@@ -585,5 +588,5 @@ fn write_other(
     } else {
         out.save_with_format(path, format)
     };
-    result.map_err(|e| HostError::failed(format!("{}: cannot write: {e}", path.display())))
+    result.map_err(|e| HostError::failed(format!("cannot write: {e}")))
 }

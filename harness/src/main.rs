@@ -250,10 +250,7 @@ fn main() {
         Ok(()) => {}
         Err(e) => {
             eprintln!("morphfx: error: {}", e.message);
-            std::process::exit(match e.kind {
-                ErrorKind::BadInput | ErrorKind::Interrupted => 2,
-                ErrorKind::Failed => 1,
-            });
+            std::process::exit(if e.kind == ErrorKind::BadInput { 2 } else { 1 });
         }
     }
 }
@@ -929,7 +926,7 @@ fn interrupted(writer: WriteBehind, done: &[i64], missing: PathBuf) -> HostError
         }
         _ => "no frame written".to_owned(),
     };
-    HostError::interrupted(format!(
+    HostError::bad(format!(
         "{}: not written: interrupted; {whole}, none after",
         missing.display()
     ))

@@ -109,7 +109,7 @@ impl From<morphfx::Error> for HostError {
         match e {
             // Only Ctrl-C or SIGTERM cancels a track here.
             morphfx::Error::Cancelled => {
-                HostError::interrupted("interrupted before tracking finished: nothing was written")
+                HostError::bad("interrupted before tracking finished: nothing was written")
             }
             e => HostError::bad(e.to_string()),
         }

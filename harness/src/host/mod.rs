@@ -37,12 +37,11 @@ pub const BAD_INPUT_ID: &str = "net.morphfx.BadInput";
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum ErrorKind {
-    /// Exit status 2: the input is at fault.
+    /// Exit status 2: the input is at fault, an output could not be
+    /// written, or the run was interrupted (the message says which).
     BadInput,
     /// Exit status 1.
     Failed,
-    /// Stopped by Ctrl-C or SIGTERM ([`crate::interrupt`]).
-    Interrupted,
 }
 
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -61,12 +60,6 @@ impl HostError {
     pub fn failed(m: impl Into<String>) -> Self {
         HostError {
             kind: ErrorKind::Failed,
-            message: m.into(),
-        }
-    }
-    pub fn interrupted(m: impl Into<String>) -> Self {
-        HostError {
-            kind: ErrorKind::Interrupted,
             message: m.into(),
         }
     }

@@ -343,9 +343,6 @@ unsafe extern "C" fn delete_all_keys(h: OfxParamHandle) -> OfxStatus {
         let Some(p) = (unsafe { param_of(h) }) else {
             return kOfxStatErrBadHandle;
         };
-        if super::misuse::params_unreadable() {
-            return kOfxStatErrUnknown;
-        }
         let v = p.value_at(0.0);
         p.set(v);
         kOfxStatOK
