@@ -395,6 +395,24 @@ void checkTrack(Effect &fx, const Where &w) {
   keyLines(fx, w);
 }
 
+/// Actions sent with no effect handle, as a broken host might, straight to
+/// the plugin's main entry: each must come back kOfxStatErrBadHandle (and
+/// the plugin says why through this library's message suite, which takes a
+/// null handle), never a crash.
+void checkNullHandle(IE::ImageEffectPlugin &plugin, const Where &w) {
+  OfxPlugin *raw = plugin.getPluginHandle()->getOfxPlugin();
+  if (!raw || !raw->mainEntry) return fail(w.text + ": no main entry");
+  for (const char *action : {kOfxImageEffectActionRender, kOfxImageEffectActionIsIdentity,
+                             kOfxImageEffectActionGetRegionOfDefinition,
+                             kOfxActionInstanceChanged}) {
+    const OfxStatus s = raw->mainEntry(action, nullptr, nullptr, nullptr);
+    if (s != kOfxStatErrBadHandle)
+      fail(w.text + ": " + action + " with a null handle returned " + statusName(s));
+  }
+  // The library prints messages with no effect as they come, unterminated.
+  std::cout << std::endl;
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -476,6 +494,8 @@ int main(int argc, char **argv) {
         ++checked;
       }
     }
+    // Loaded by now (the instances above), so it has the message suite.
+    checkNullHandle(*plugin, {std::string(node.id) + ", null handle"});
   }
   OFX::Host::PluginCache::clearPluginCache();
 

@@ -41,7 +41,13 @@ pub fn check(bundle: &Path) {
     for skipped in text.lines().filter(|l| l.contains("SKIPPED")) {
         println!("{skipped}");
     }
-    let summary = text.lines().last().unwrap_or_default();
+    // Our own last line: the plugin may say things on stderr after it.
+    let summary = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .rev()
+        .find(|l| l.starts_with("refhost: "))
+        .unwrap_or_default()
+        .to_owned();
     println!("reference host check (OpenFX HostSupport): {summary}");
 }
 
