@@ -413,6 +413,63 @@ void checkNullHandle(IE::ImageEffectPlugin &plugin, const Where &w) {
   std::cout << std::endl;
 }
 
+/// A render that fails for a real reason (a scene file that is not there)
+/// leaves the plugin's words on the node, as the library formats them:
+/// the `%` in the path arrives as written, not read as a conversion.
+void checkFailureMessage(Effect &fx, const Where &w) {
+  auto *file = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_file"));
+  if (!file) return fail(w.text + ": no string param scene_file");
+  const std::string path = "/no/such/folder/take 100%d %s.morph.json";
+  file->set(path.c_str());
+  const OfxPointD scale = {1, 1};
+  fx.renderScale = scale;
+  fx.renderWindow = {0, 0, kProjectWidth, kProjectHeight};
+  fx.persistentError.clear();
+  expectOk(fx.beginRenderAction(0, 0, 1, false, scale, true, false), w, "beginSequenceRender");
+  fx.rendering = true;
+  const OfxStatus s =
+      fx.renderAction(0, kOfxImageFieldNone, fx.renderWindow, scale, true, false, false);
+  fx.rendering = false;
+  expectOk(fx.endRenderAction(0, 0, 1, false, scale, true, false), w, "endSequenceRender");
+  if (s != kOfxStatFailed)
+    fail(w.text + ": a render with a missing scene file returned " + statusName(s));
+  if (fx.persistentError.find("scene file " + path + ": ") == std::string::npos)
+    fail(w.text + ": the failed render's message arrived as '" + fx.persistentError + "'");
+  file->set("");
+}
+
+/// A node just made, nothing connected, as Natron asks of it at once:
+/// region of definition, clip preferences, regions of interest, frames
+/// needed and identity each answer without a failure status, and nothing
+/// is left on the node (a persistent error is an ERROR badge there). The
+/// library fills in its default region where the plugin replies default.
+void checkUnconnected(IE::ImageEffectPlugin &plugin, const std::string &context,
+                      const Where &where) {
+  const Where w = where.with(context).with("nothing connected");
+  std::unique_ptr<IE::Instance> made(plugin.createInstance(context, nullptr));
+  auto *fx = dynamic_cast<Effect *>(made.get());
+  if (!fx) return fail(w.text + ": no instance (describe in context failed)");
+  fx->connected = false;
+  expectOk(fx->createInstanceAction(), w, "createInstance");
+  const OfxPointD scale = {1, 1};
+  OfxRectD rod = {0, 0, 0, 0};
+  expectOk(fx->getRegionOfDefinitionAction(0, scale, rod), w, "getRegionOfDefinition");
+  if (!fx->getClipPreferences()) fail(w.text + ": getClipPreferences failed");
+  const OfxRectD project = {0, 0, double(kProjectWidth), double(kProjectHeight)};
+  std::map<IE::ClipInstance *, OfxRectD> rois;
+  expectOk(fx->getRegionOfInterestAction(0, scale, project, rois), w, "getRegionsOfInterest");
+  IE::RangeMap ranges;
+  expectOk(fx->getFrameNeededAction(0, ranges), w, "getFramesNeeded");
+  OfxTime time = 0;
+  std::string clip;
+  const OfxRectI win = {0, 0, kProjectWidth, kProjectHeight};
+  const OfxStatus s = fx->isIdentityAction(time, kOfxImageFieldNone, win, scale, clip);
+  if (s == kOfxStatOK) fail(w.text + ": identity to clip '" + clip + "', which is not connected");
+  expectOk(s, w, "isIdentity");
+  if (!fx->persistentError.empty())
+    fail(w.text + ": left an error on the node: " + fx->persistentError);
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -434,6 +491,7 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
   if (!fx->getClipPreferences()) fail(w.text + ": getClipPreferences failed");
   checkIdentity(*fx, context, w);
   if (depth == std::string(kOfxBitDepthFloat)) {
+    checkFailureMessage(*fx, w.with("missing scene file"));
     checkOverlay(*fx, w.with("overlay"));
     checkOverlayGl(*fx, w.with("overlay in OpenGL"));
     if (inputClips(*fx).size() == 2) checkTrack(*fx, w.with("track"));
@@ -489,6 +547,7 @@ int main(int argc, char **argv) {
         fail(std::string(node.id) + ": context " + context + " not offered");
         continue;
       }
+      checkUnconnected(*plugin, context, {node.id});
       for (const char *depth : {kOfxBitDepthFloat, kOfxBitDepthByte}) {
         checkContext(*plugin, context, depth, {node.id});
         ++checked;

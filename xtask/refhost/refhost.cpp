@@ -376,12 +376,14 @@ const std::string &Clip::getFieldOrder() const {
   static const std::string none = kOfxImageFieldNone;
   return none;
 }
-bool Clip::getConnected() const { return true; }
+bool Clip::getConnected() const { return isOutput() || effect_->connected; }
 double Clip::getUnmappedFrameRate() const { return 24.0; }
 void Clip::getUnmappedFrameRange(double &s, double &e) const { s = 0, e = 10; }
 bool Clip::getContinuousSamples() const { return false; }
 
 OfxRectD Clip::getRegionOfDefinition(OfxTime) const {
+  // An unconnected clip has no picture, so no region.
+  if (!getConnected()) return OfxRectD{0, 0, 0, 0};
   OfxRectD r = {0, 0, double(kProjectWidth), double(kProjectHeight)};
   return r;
 }
@@ -404,6 +406,7 @@ OFX::Host::ImageEffect::Image *Clip::getImage(OfxTime time,
                                               const OfxRectD *bounds) {
   const OfxPointD scale = effect_->renderScale;
   const OfxRectI rod = toPixels(getRegionOfDefinition(time), scale);
+  if (!getConnected()) return nullptr;
   auto px = std::make_shared<Pixels>();
   px->depth = getPixelDepth();
   if (isOutput()) {

@@ -76,6 +76,8 @@ class Effect : public OFX::Host::ImageEffect::Instance {
   OfxRectI renderWindow = {0, 0, kProjectWidth, kProjectHeight};
   std::map<OFX::Host::ImageEffect::ClipInstance *, OfxRectD> regionsOfInterest;
   bool rendering = false;
+  /// Whether the input clips are connected (a node just made has none).
+  bool connected = true;
   /// The persistent message the plugin last set (empty once cleared).
   std::string persistentError;
 

@@ -24,6 +24,9 @@ pub enum Misuse {
     TamperImage(&'static str, fn(&PropertySet)),
     /// `paramGetValue` and `paramGetValueAtTime` answer `kOfxStatErrUnknown`.
     UnreadableParams,
+    /// The message suites print a message's format without its arguments,
+    /// as Natron 2.5 does: `%%` as `%`, any other conversion as nothing.
+    MessageArgumentsLost,
 }
 
 static ARMED: Mutex<Vec<Misuse>> = Mutex::new(Vec::new());
@@ -81,4 +84,14 @@ pub(crate) fn params_unreadable() -> bool {
     armed()
         .iter()
         .any(|m| matches!(m, Misuse::UnreadableParams))
+}
+
+/// Asked by the message suites' C shim for each message.
+#[unsafe(no_mangle)]
+pub extern "C" fn mfx_messages_lose_arguments() -> std::ffi::c_int {
+    super::guard::guard(0, "mfx_messages_lose_arguments", || {
+        armed()
+            .iter()
+            .any(|m| matches!(m, Misuse::MessageArgumentsLost)) as std::ffi::c_int
+    })
 }

@@ -912,12 +912,19 @@ impl Instance<'_> {
         Ok(out)
     }
 
-    /// The output's region of definition at `time` (canonical).
+    /// The output's region of definition at `time` (canonical): the
+    /// plugin's, or where it replies default, the host's default.
     pub fn region_of_definition(&self, time: f64, scale: (f64, f64)) -> Result<RectI, HostError> {
         let a = PropertySet::new();
         a.set_double(kOfxPropTime, &[time]);
         a.set_double(kOfxImageEffectPropRenderScale, &[scale.0, scale.1]);
         let out = PropertySet::new();
+        // The spec: the host sets the out-arg to the default first.
+        let d = self.default_region(time);
+        out.set_double(
+            kOfxImageEffectPropRegionOfDefinition,
+            &[d.x1 as f64, d.y1 as f64, d.x2 as f64, d.y2 as f64],
+        );
         self.act(
             kOfxImageEffectActionGetRegionOfDefinition,
             Some(&a),
@@ -933,6 +940,28 @@ impl Instance<'_> {
             r[2].ceil() as i32,
             r[3].ceil() as i32,
         ))
+    }
+
+    /// The spec's default region of definition, as for the filter,
+    /// transition and general contexts: the union of the (non-optional)
+    /// input clips' regions; this host gives an unconnected clip none, and
+    /// with none at all the default is the project's.
+    fn default_region(&self, time: f64) -> RectI {
+        let clips = self.effect.clips.lock().unwrap_or_else(|e| e.into_inner());
+        clips
+            .iter()
+            .filter(|c| c.name != "Output")
+            .filter(|c| c.props.ints(kOfxImageClipPropOptional).first() != Some(&1))
+            .filter_map(|c| c.rod(time))
+            .reduce(|u, r| {
+                RectI::new(
+                    u.x1.min(r.x1),
+                    u.y1.min(r.y1),
+                    u.x2.max(r.x2),
+                    u.y2.max(r.y2),
+                )
+            })
+            .unwrap_or_else(|| self.project_rect())
     }
 
     /// Asks the plugin whether the output at `time` is one of its sources

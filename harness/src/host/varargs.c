@@ -70,10 +70,37 @@ OfxStatus mfx_paramSetValueAtTime(void *h, double time, ...) {
 OfxStatus mfx_paramGetDerivative(void *h, double time, ...) { (void)h; (void)time; return 5; /* kOfxStatErrUnsupported */ }
 OfxStatus mfx_paramGetIntegral(void *h, double t1, double t2, ...) { (void)h; (void)t1; (void)t2; return 5; }
 
+/* Armed as a misuse (host::misuse): the host loses a message's arguments,
+ * as Natron 2.5 does (it passes the va_list on as if it were one argument).
+ * The format is printed as such a host shows it: "%%" as "%", every other
+ * conversion as nothing (Natron's "%s" tooltip read blank). */
+extern int mfx_messages_lose_arguments(void);
+
+static void format_without_arguments(const char *f, char *buf, size_t n) {
+    size_t o = 0;
+    while (*f && o + 1 < n) {
+        if (*f != '%') { buf[o++] = *f++; continue; }
+        f++;
+        if (*f == '%') { buf[o++] = '%'; f++; continue; }
+        /* flags, width, precision and length, then the conversion letter */
+        while (*f && !((*f >= 'a' && *f <= 'z' && *f != 'h' && *f != 'l' && *f != 'j' &&
+                        *f != 'z' && *f != 't') || (*f >= 'A' && *f <= 'Z' && *f != 'L')))
+            f++;
+        if (*f) f++;
+    }
+    buf[o] = 0;
+}
+
+static void format_message(char *buf, size_t n, const char *format, va_list ap) {
+    if (!format) format = "";
+    if (mfx_messages_lose_arguments()) format_without_arguments(format, buf, n);
+    else vsnprintf(buf, n, format, ap);
+}
+
 OfxStatus mfx_message(void *handle, const char *type, const char *id, const char *format, ...) {
     char buf[4096];
     va_list ap; va_start(ap, format);
-    vsnprintf(buf, sizeof buf, format ? format : "", ap);
+    format_message(buf, sizeof buf, format, ap);
     va_end(ap);
     return mfx_message_text(handle, type, id, buf);
 }
@@ -81,7 +108,7 @@ OfxStatus mfx_message(void *handle, const char *type, const char *id, const char
 OfxStatus mfx_persistent_message(void *handle, const char *type, const char *id, const char *format, ...) {
     char buf[4096];
     va_list ap; va_start(ap, format);
-    vsnprintf(buf, sizeof buf, format ? format : "", ap);
+    format_message(buf, sizeof buf, format, ap);
     va_end(ap);
     return mfx_persistent_text(handle, type, id, buf);
 }

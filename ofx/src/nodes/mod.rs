@@ -105,7 +105,7 @@ pub fn action(
     } else if is(action, kOfxActionPurgeCaches) {
         instance::get(&effect)?.purge();
     } else if is(action, kOfxImageEffectActionGetRegionOfDefinition) {
-        render::region_of_definition(kind, &effect, &in_props()?, &out_props()?)?;
+        return render::region_of_definition(kind, &effect, &in_props()?, &out_props()?);
     } else if is(action, kOfxImageEffectActionGetRegionsOfInterest) {
         render::regions_of_interest(kind, &effect, &in_props()?, &out_props()?)?;
     } else if is(action, kOfxImageEffectActionGetFramesNeeded) {

@@ -150,15 +150,15 @@ impl Effect {
             return;
         };
         let Some(f) = suite.message else { return };
-        let text = CString::new(text.replace('\0', " ")).unwrap_or_default();
+        let text = super::printf_literal(text);
         // SAFETY: the host's message function, given our effect handle, a
-        // message type and id it knows, and a "%s" format with one C string.
+        // message type and id it knows, and a format with no conversion
+        // (every `%` doubled), so no variadic argument is read.
         unsafe {
             f(
                 self.handle as *mut c_void,
                 kind.as_ptr(),
                 id.as_ptr(),
-                c"%s".as_ptr(),
                 text.as_ptr(),
             );
         }
@@ -175,15 +175,15 @@ impl Effect {
         let Some(f) = self.suites.message_v2.and_then(|s| s.setPersistentMessage) else {
             return false;
         };
-        let text = CString::new(text.replace('\0', " ")).unwrap_or_default();
+        let text = super::printf_literal(text);
         // SAFETY: the host's function, given our instance handle, a message
-        // type and id it knows, and a "%s" format with one C string.
+        // type and id it knows, and a format with no conversion (every `%`
+        // doubled), so no variadic argument is read.
         let status = unsafe {
             f(
                 self.handle as *mut c_void,
                 kOfxMessageError.as_ptr(),
                 id.as_ptr(),
-                c"%s".as_ptr(),
                 text.as_ptr(),
             )
         };

@@ -136,25 +136,24 @@ pub fn unowned_error(id: &CStr, text: &str) {
     // SAFETY: null, or the suite the host returned for this name and
     // version in our load action, valid while the binary is loaded.
     let message = unsafe { suite.as_ref() }.and_then(|s| s.message);
-    let text = std::ffi::CString::new(text.replace('\0', " ")).unwrap_or_default();
+    let format = super::printf_literal(text);
     let status = match message {
         // SAFETY: the host's message function: a null handle (allowed by
-        // the v1 suite), a message type and id, and a "%s" format with one
-        // C string.
+        // the v1 suite), a message type and id, and a format with no
+        // conversion (every `%` doubled), so no variadic argument is read.
         Some(f) => unsafe {
             f(
                 std::ptr::null_mut(),
                 kOfxMessageError.as_ptr(),
                 id.as_ptr(),
-                c"%s".as_ptr(),
-                text.as_ptr(),
+                format.as_ptr(),
             )
         },
         None => kOfxStatErrMissingHostFeature,
     };
     if status != kOfxStatOK {
         use std::io::Write;
-        let _ = writeln!(std::io::stderr(), "MorphFX: {}", text.to_string_lossy());
+        let _ = writeln!(std::io::stderr(), "MorphFX: {text}");
     }
 }
 

@@ -31,7 +31,7 @@ pub mod interact;
 pub mod params;
 pub mod props;
 
-use std::ffi::CStr;
+use std::ffi::{CStr, CString};
 
 use openfx::sys::generic::core::*;
 
@@ -86,6 +86,15 @@ impl Failure {
             Failure::BadInput(m) | Failure::Failed(m) | Failure::Status(_, m) => m,
         }
     }
+}
+
+/// `text` as a printf format that prints it as it is: every `%` doubled and
+/// NULs made spaces. Messages go to the host as the format alone, with no
+/// variadic argument: Natron 2.5 passes a message's `va_list` on as if it
+/// were one argument, so a `"%s"` format with the text beside it arrives
+/// blank there, while a format with no conversion reads nothing in any host.
+pub fn printf_literal(text: &str) -> CString {
+    CString::new(text.replace('\0', " ").replace('%', "%%")).unwrap_or_default()
 }
 
 /// Turns a host status into a result, naming the call that produced it.

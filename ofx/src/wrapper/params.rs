@@ -172,9 +172,12 @@ fn set_kind(p: &PropSet, kind: &Kind) -> Outcome {
         }
         Kind::Point { default } => {
             p.set_doubles(kOfxParamPropDefault, &[default.0, default.1])?;
-            // The host's own point handle stays, beside our overlay; a host
-            // that does not know the property refuses it, and that is fine.
-            let _ = p.set_int(kOfxParamPropUseHostOverlayHandle, 0, 1);
+            // No host handle (kOfxParamPropUseHostOverlayHandle left 0): the
+            // nodes' own overlay draws and drags every position, and a host
+            // that also drew its crosshair and the param's script name at
+            // each of 64 x 4 ends (Natron does) would bury the lines and
+            // catch the pen. Nuke draws host handles beside a plugin's
+            // overlay only for params that set the property, so it agrees.
             // A real range and display range: hosts that find none clamp
             // (Resolve to -1..1). Positions may lie outside the frame
             // (overscan), so the range is wide; sliders show a 4K frame.

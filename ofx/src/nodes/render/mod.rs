@@ -173,7 +173,13 @@ fn gather(
         .clip("Output")?
         .image(time)?
         .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
-    let rod = regions::output_region(kind, effect, &context, time)?;
+    // The spec: non-optional clips are always connected during a render.
+    let rod = regions::output_region(kind, effect, &context, time)?.ok_or_else(|| {
+        Failure::BadInput(format!(
+            "no source clip of {} is connected",
+            kind.info().label
+        ))
+    })?;
     // Triangles pin the border of the frame, so the whole frame warps.
     inputs.warp.region = Some(regions::warp_region(effect, &rod));
     let out_scale = scale_of(out.info());

@@ -14,7 +14,7 @@ use crate::nodes::params::{Reader, Settings, OFFSET_A, OFFSET_B};
 use crate::nodes::NodeKind;
 use crate::wrapper::clips::Effect;
 use crate::wrapper::props::PropSet;
-use crate::wrapper::{Failure, Outcome, Reply};
+use crate::wrapper::{Outcome, Reply};
 
 /// Each source clip in `context` and the time it is read at for output
 /// time `time` (its frame offset added).
@@ -50,13 +50,15 @@ fn offsets(kind: NodeKind, effect: &Effect, time: f64) -> (f64, f64) {
 /// The output's region of definition at `time`: the union of the connected
 /// sources' regions, each at the time (offset included) it is read - what
 /// hosts' own dissolves do with inputs of different data windows. The
-/// region of definition action and the render use this one answer.
+/// region of definition action and the render use this one answer: `None`
+/// while no source is connected (the spec's interface actions may come
+/// then; a render may not).
 pub(super) fn output_region(
     kind: NodeKind,
     effect: &Effect,
     context: &str,
     time: f64,
-) -> Outcome<OfxRectD> {
+) -> Outcome<Option<OfxRectD>> {
     let mut union: Option<OfxRectD> = None;
     for (name, at) in source_times(kind, effect, context, time) {
         let clip = effect.clip(name)?;
@@ -78,26 +80,28 @@ pub(super) fn output_region(
             },
         });
     }
-    union.ok_or_else(|| {
-        Failure::BadInput(format!(
-            "no source clip of {} is connected",
-            kind.info().label
-        ))
-    })
+    Ok(union)
 }
 
+/// The region of definition; left to the host (its default, which the spec
+/// defines per context) while no source is connected: a node just made is
+/// not in error, and hosts ask before anything is connected (Natron at
+/// once, showing a failure as an ERROR badge on the new node).
 pub fn region_of_definition(
     kind: NodeKind,
     effect: &Effect,
     in_args: &PropSet,
     out_args: &PropSet,
-) -> Outcome {
+) -> Outcome<Reply> {
     let time = in_args.get_double(kOfxPropTime, 0)?;
-    let rod = output_region(kind, effect, &context(effect), time)?;
+    let Some(rod) = output_region(kind, effect, &context(effect), time)? else {
+        return Ok(Reply::Default);
+    };
     out_args.set_doubles(
         kOfxImageEffectPropRegionOfDefinition,
         &[rod.x1, rod.y1, rod.x2, rod.y2],
-    )
+    )?;
+    Ok(Reply::Done)
 }
 
 /// Clip preferences: the output changes from frame to frame (line slots,
