@@ -413,3 +413,114 @@ fn a_render_window_beyond_any_machine_is_refused_before_any_allocation() {
     // The instance is unharmed: a proper render still works.
     inst.render(0.0, OutputSpec::default()).unwrap();
 }
+
+/// The OFX types a host may make a param with, as far as values go.
+const PARAM_TYPES: [&str; 7] = [
+    "OfxParamTypeDouble",
+    "OfxParamTypeDouble2D",
+    "OfxParamTypeInteger",
+    "OfxParamTypeBoolean",
+    "OfxParamTypeChoice",
+    "OfxParamTypeString",
+    "OfxParamTypeGroup",
+];
+
+/// Every type but those a param declared as `declared` takes the values of.
+fn wrong_types(declared: &str) -> Vec<&'static str> {
+    let ints = [
+        "OfxParamTypeInteger",
+        "OfxParamTypeBoolean",
+        "OfxParamTypeChoice",
+    ];
+    PARAM_TYPES
+        .into_iter()
+        .filter(|t| *t != declared && !(ints.contains(t) && ints.contains(&declared)))
+        .collect()
+}
+
+/// A host that made `param` with another type than the plugin declared
+/// (`wrong`): the action reading or writing it fails naming the param, and
+/// the plugin never calls the host's value functions on it, so the host
+/// never writes through a pointer sized for another type.
+fn refuses_param_of_wrong_type(
+    param: &'static str,
+    wrong: &'static str,
+    act: fn(&Instance) -> String,
+) {
+    let (_armed, bundle) = host(&[Misuse::ParamType(param, wrong)]);
+    let inst = bundle
+        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
+        .unwrap();
+    let img = Image::from_fn(RectI::from_size(32, 24), 4, |i, j, c| {
+        if c == 3 {
+            1.0
+        } else {
+            (i + 2 * j + c as i32) as f32 * 0.01
+        }
+    });
+    let frame = Arc::new(Frame::from_image(&img, "OfxBitDepthFloat", false));
+    inst.connect("Source", Arc::new(Still(frame))).unwrap();
+    inst.set_project(32.0, 24.0);
+    if param != "line_count" {
+        inst.set_int("line_count", 1).unwrap();
+    }
+    let why = act(&inst);
+    assert!(
+        why.contains(param),
+        "{param} made as {wrong}: the failure does not name it: {why}"
+    );
+    assert_eq!(
+        inst.value_calls(param),
+        0,
+        "{param} made as {wrong}: the plugin called the host's value functions on it"
+    );
+}
+
+fn render_fails(inst: &Instance) -> String {
+    let spec = OutputSpec {
+        identity: false,
+        ..OutputSpec::default()
+    };
+    match inst.render(0.0, spec) {
+        Ok(_) => String::from("the render succeeded"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn clear_line_fails(inst: &Instance) -> String {
+    match inst.instance_changed("line1_clear", 0.0) {
+        Ok(()) => String::from("Clear Line succeeded"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn a_param_the_host_made_with_another_type_is_never_read_through_the_wrong_pointer() {
+    // Reads at render time: one param of each declared type.
+    for (param, declared) in [
+        ("progress", "OfxParamTypeDouble"),
+        ("line_count", "OfxParamTypeInteger"),
+        ("use_scene_progress", "OfxParamTypeBoolean"),
+        ("method", "OfxParamTypeChoice"),
+        ("line1_a_start", "OfxParamTypeDouble2D"),
+        ("scene_text", "OfxParamTypeString"),
+    ] {
+        for wrong in wrong_types(declared) {
+            refuses_param_of_wrong_type(param, wrong, render_fails);
+        }
+    }
+}
+
+#[test]
+fn a_param_the_host_made_with_another_type_is_never_written_through_the_wrong_values() {
+    // Clear Line writes a position and two integers without reading them first.
+    for (param, declared) in [
+        ("line1_b_end", "OfxParamTypeDouble2D"),
+        ("line1_enable", "OfxParamTypeBoolean"),
+        ("line_count", "OfxParamTypeInteger"),
+    ] {
+        for wrong in wrong_types(declared) {
+            refuses_param_of_wrong_type(param, wrong, clear_line_fails);
+        }
+    }
+}

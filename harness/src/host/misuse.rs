@@ -24,6 +24,9 @@ pub enum Misuse {
     TamperImage(&'static str, fn(&PropertySet)),
     /// `paramGetValue` and `paramGetValueAtTime` answer `kOfxStatErrUnknown`.
     UnreadableParams,
+    /// The instance's param (first) is made with another OFX type
+    /// (second) than its descriptor has.
+    ParamType(&'static str, &'static str),
     /// The message suites print a message's format without its arguments,
     /// as Natron 2.5 does: `%%` as `%`, any other conversion as nothing.
     MessageArgumentsLost,
@@ -84,6 +87,14 @@ pub(crate) fn params_unreadable() -> bool {
     armed()
         .iter()
         .any(|m| matches!(m, Misuse::UnreadableParams))
+}
+
+/// The type an instance's param `name` is armed to be made with.
+pub(crate) fn param_type(name: &str) -> Option<&'static str> {
+    armed().iter().find_map(|m| match m {
+        Misuse::ParamType(p, kind) if *p == name => Some(*kind),
+        _ => None,
+    })
 }
 
 /// Asked by the message suites' C shim for each message.

@@ -842,6 +842,14 @@ impl Instance<'_> {
         }
     }
 
+    /// How many calls of the variadic value functions (get or set) the
+    /// plugin made on param `name` so far.
+    pub fn value_calls(&self, name: &str) -> usize {
+        self.effect.params.get(name).map_or(0, |p| {
+            p.value_calls.load(std::sync::atomic::Ordering::Relaxed)
+        })
+    }
+
     /// Sends `action` as a misbehaving host might (tests of the plugin's
     /// answers): with no effect handle when `null_handle`, and the
     /// arguments as given. The plugin's status, as it answered, and the

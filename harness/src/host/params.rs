@@ -30,6 +30,9 @@ pub struct Param {
     pub kind: String,
     pub props: PropertySet,
     state: Mutex<(ParamValue, Vec<(f64, ParamValue)>)>,
+    /// Calls of the variadic value functions (get and set, at a time or
+    /// not) the plugin made on this param.
+    pub value_calls: std::sync::atomic::AtomicUsize,
 }
 
 impl Param {
@@ -48,11 +51,24 @@ impl Param {
         }
     }
 
-    /// A param of an instance, valued at its descriptor's default.
+    /// A param of an instance, valued at its descriptor's default (of the
+    /// type a test armed this host to make it with instead, if any).
     pub fn instance_of(desc: &Param) -> Param {
         let props = desc.props.clone_values();
+        let mut p = Param {
+            name: desc.name.clone(),
+            kind: desc.kind.clone(),
+            props,
+            state: Mutex::new(Default::default()),
+            value_calls: Default::default(),
+        };
+        if let Some(kind) = super::misuse::param_type(&desc.name) {
+            p.kind = kind.to_owned();
+            p.props.set_str(kOfxParamPropType, kind);
+        }
+        let props = &p.props;
         let mut v = ParamValue::default();
-        match desc.shape() {
+        match p.shape() {
             Shape::Double(n) => {
                 for (k, d) in props
                     .doubles(kOfxParamPropDefault)
@@ -79,12 +95,8 @@ impl Param {
             }
             Shape::None => {}
         }
-        Param {
-            name: desc.name.clone(),
-            kind: desc.kind.clone(),
-            props,
-            state: Mutex::new((v, Vec::new())),
-        }
+        p.set(v);
+        p
     }
 
     fn state(&self) -> std::sync::MutexGuard<'_, (ParamValue, Vec<(f64, ParamValue)>)> {
@@ -216,6 +228,7 @@ unsafe extern "C" fn param_define(
             kind: kind.to_string_lossy().into_owned(),
             props: PropertySet::new(),
             state: Mutex::new(Default::default()),
+            value_calls: Default::default(),
         });
         p.props.set_str(kOfxParamPropType, &p.kind);
         p.props.set_str(kOfxPropName, &name);
@@ -471,6 +484,9 @@ pub unsafe extern "C" fn mfx_param_shape(
         let Some(p) = (unsafe { param_of(h) }) else {
             return kOfxStatErrBadHandle;
         };
+        // Every variadic value call asks the shape first.
+        p.value_calls
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let (k, d) = match p.shape() {
             Shape::Double(n) => (0, n),
             Shape::Int(n) => (1, n),
@@ -631,6 +647,7 @@ mod tests {
             kind: "OfxParamTypeDouble".into(),
             props: PropertySet::new(),
             state: Mutex::new(Default::default()),
+            value_calls: Default::default(),
         };
         {
             let _in = Inside::action(c"OfxActionInstanceChanged");

@@ -94,9 +94,7 @@ impl Instance {
 /// Makes the instance's state, with a handle for every param it defines.
 pub fn create(kind: NodeKind, effect: &Effect) -> Outcome {
     let table = table_in_context(kind, &context(effect));
-    let params = effect
-        .param_set()?
-        .bind(table.iter().map(|p| p.id.as_str()));
+    let params = effect.param_set()?.bind(&table);
     super::lines::hide_unused(kind, &params, 0.0);
     let instance = Instance {
         params: Some(params),

@@ -54,18 +54,39 @@ impl ParamSet {
         Ok(())
     }
 
-    /// The handles of the params named `ids`, fetched once (an instance
-    /// keeps them for its life). A param the host cannot hand over is left
-    /// out: reading it fails, and the reader falls back to its default.
-    pub fn bind<'a>(&self, ids: impl IntoIterator<Item = &'a str>) -> Params {
-        let handles = ids
+    /// The params of `specs`, their handles and types fetched once (an
+    /// instance keeps them for its life). A param the host cannot hand over
+    /// is left out: reading it fails, and the reader falls back to its
+    /// default. Each remembers the type the host made it with (the type it
+    /// was defined with, where the host does not say), and every read and
+    /// write checks it before handing the host a pointer.
+    pub fn bind<'a>(&self, specs: impl IntoIterator<Item = &'a ParamSpec>) -> Params {
+        let handles = specs
             .into_iter()
-            .filter_map(|id| Some((id.to_owned(), self.handle(id).ok()?)))
+            .filter_map(|spec| {
+                let handle = self.handle(&spec.id).ok()?;
+                let kind = self
+                    .host_type(handle)
+                    .unwrap_or_else(|| ParamType::declared(&spec.kind));
+                Some((spec.id.clone(), Param { handle, kind }))
+            })
             .collect();
         Params {
             set: *self,
             handles,
         }
+    }
+
+    /// The type the host says `handle`'s param has (`kOfxParamPropType`).
+    fn host_type(&self, handle: OfxParamHandle) -> Option<ParamType> {
+        let f = self.suite.paramGetPropertySet?;
+        let mut props: OfxPropertySetHandle = std::ptr::null_mut();
+        // SAFETY: a handle the host just gave for this set, and a live out-pointer.
+        check(unsafe { f(handle, &mut props) }, "paramGetPropertySet").ok()?;
+        // SAFETY: the host just returned the param's property set.
+        let props = unsafe { PropSet::from_raw(props) }.ok()?;
+        let name = props.get_string(kOfxParamPropType, 0).ok()?;
+        Some(ParamType::named(&name))
     }
 
     fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
@@ -222,10 +243,95 @@ fn need<F>(f: Option<F>, name: &str) -> Outcome<F> {
     f.ok_or_else(|| Failure::Failed(format!("host has no {name}")))
 }
 
+/// An OFX param type, as far as reading and writing values goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamType {
+    Double,
+    Double2D,
+    Integer,
+    Boolean,
+    Choice,
+    String,
+    /// Any other type (groups, buttons, pages, 3D, colours, ...).
+    Other,
+}
+
+impl ParamType {
+    /// The type named by a `kOfxParamPropType` value.
+    pub fn named(name: &str) -> ParamType {
+        let is = |t: &CStr| t.to_bytes() == name.as_bytes();
+        if is(kOfxParamTypeDouble) {
+            ParamType::Double
+        } else if is(kOfxParamTypeDouble2D) {
+            ParamType::Double2D
+        } else if is(kOfxParamTypeInteger) {
+            ParamType::Integer
+        } else if is(kOfxParamTypeBoolean) {
+            ParamType::Boolean
+        } else if is(kOfxParamTypeChoice) {
+            ParamType::Choice
+        } else if is(kOfxParamTypeString) {
+            ParamType::String
+        } else {
+            ParamType::Other
+        }
+    }
+
+    /// The type a param of `kind` is defined with.
+    fn declared(kind: &Kind) -> ParamType {
+        match kind {
+            Kind::Double { .. } | Kind::HostDriven { .. } => ParamType::Double,
+            Kind::Point { .. } => ParamType::Double2D,
+            Kind::Int { .. } => ParamType::Integer,
+            Kind::Bool { .. } => ParamType::Boolean,
+            Kind::Choice { .. } => ParamType::Choice,
+            Kind::Text { .. } => ParamType::String,
+            Kind::Group { .. } | Kind::Button => ParamType::Other,
+        }
+    }
+}
+
+/// What the host's variadic value functions are handed for a param: the
+/// pointers (or values) an accessor passes are right only for these types.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Values {
+    /// One `double` (or `double*`): Double params.
+    OneDouble,
+    /// Two `double`s (or `double*`s): Double2D params.
+    TwoDoubles,
+    /// One `int` (or `int*`): Integer, Boolean and Choice params.
+    OneInt,
+    /// One `char*` (or `char**`): String params.
+    OneString,
+}
+
+impl Values {
+    /// Whether a param of type `t` takes these values.
+    pub fn fit(self, t: ParamType) -> bool {
+        matches!(
+            (self, t),
+            (Values::OneDouble, ParamType::Double)
+                | (Values::TwoDoubles, ParamType::Double2D)
+                | (
+                    Values::OneInt,
+                    ParamType::Integer | ParamType::Boolean | ParamType::Choice
+                )
+                | (Values::OneString, ParamType::String)
+        )
+    }
+}
+
+/// A param's handle and the type it was made with.
+#[derive(Clone, Copy)]
+struct Param {
+    handle: OfxParamHandle,
+    kind: ParamType,
+}
+
 /// One instance's params, their handles fetched once.
 pub struct Params {
     set: ParamSet,
-    handles: HashMap<String, OfxParamHandle>,
+    handles: HashMap<String, Param>,
 }
 
 // SAFETY: param handles are the host's, valid for the instance's life
@@ -243,7 +349,7 @@ impl Params {
         self.handles.contains_key(id)
     }
 
-    fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
+    fn param(&self, id: &str) -> Outcome<Param> {
         self.handles.get(id).copied().ok_or_else(|| {
             Failure::Status(
                 kOfxStatErrUnknown,
@@ -252,21 +358,44 @@ impl Params {
         })
     }
 
+    /// The handle of any param (keys, properties: no values passed).
+    fn handle(&self, id: &str) -> Outcome<OfxParamHandle> {
+        self.param(id).map(|p| p.handle)
+    }
+
+    /// The handle of a param that takes `values`; a param of another type
+    /// is an error naming it, and the host is never called with pointers
+    /// its type does not take.
+    fn typed(&self, id: &str, values: Values) -> Outcome<OfxParamHandle> {
+        let p = self.param(id)?;
+        if values.fit(p.kind) {
+            Ok(p.handle)
+        } else {
+            Err(Failure::Failed(format!(
+                "param {id} is a {:?} param in this host, which does not take {values:?}",
+                p.kind
+            )))
+        }
+    }
+
     fn get_at(
         &self,
         id: &str,
+        values: Values,
     ) -> Outcome<(
         OfxParamHandle,
         unsafe extern "C" fn(OfxParamHandle, OfxTime, ...) -> OfxStatus,
     )> {
+        let h = self.typed(id, values)?;
         let f = need(self.set.suite.paramGetValueAtTime, "paramGetValueAtTime")?;
-        Ok((self.handle(id)?, f))
+        Ok((h, f))
     }
 
     pub fn double(&self, id: &str, time: f64) -> Outcome<f64> {
-        let (h, f) = self.get_at(id)?;
+        let (h, f) = self.get_at(id, Values::OneDouble)?;
         let mut v = 0.0f64;
-        // SAFETY: a Double param takes one `double*` vararg (OFX param suite).
+        // SAFETY: `h` is a Double param (checked by `typed`), which takes
+        // one `double*` vararg (OFX param suite).
         let status = unsafe { f(h, time, &mut v as *mut f64) };
         check(status, &format!("reading {id}"))?;
         Ok(v)
@@ -274,18 +403,20 @@ impl Params {
 
     /// Integer, boolean and choice params all take one `int*`.
     pub fn int(&self, id: &str, time: f64) -> Outcome<i32> {
-        let (h, f) = self.get_at(id)?;
+        let (h, f) = self.get_at(id, Values::OneInt)?;
         let mut v: c_int = 0;
-        // SAFETY: Integer, Boolean and Choice params take one `int*` vararg.
+        // SAFETY: `h` is an Integer, Boolean or Choice param (checked by
+        // `typed`), which take one `int*` vararg.
         let status = unsafe { f(h, time, &mut v as *mut c_int) };
         check(status, &format!("reading {id}"))?;
         Ok(v)
     }
 
     pub fn point(&self, id: &str, time: f64) -> Outcome<(f64, f64)> {
-        let (h, f) = self.get_at(id)?;
+        let (h, f) = self.get_at(id, Values::TwoDoubles)?;
         let (mut x, mut y) = (0.0f64, 0.0f64);
-        // SAFETY: a Double2D param takes two `double*` varargs.
+        // SAFETY: `h` is a Double2D param (checked by `typed`), which
+        // takes two `double*` varargs.
         let status = unsafe { f(h, time, &mut x as *mut f64, &mut y as *mut f64) };
         check(status, &format!("reading {id}"))?;
         Ok((x, y))
@@ -293,25 +424,28 @@ impl Params {
 
     /// Keys a Double2D param at `time` (the host adds or moves the key).
     pub fn set_point_at(&self, id: &str, time: f64, (x, y): (f64, f64)) -> Outcome {
+        let h = self.typed(id, Values::TwoDoubles)?;
         let f = need(self.set.suite.paramSetValueAtTime, "paramSetValueAtTime")?;
-        let h = self.handle(id)?;
-        // SAFETY: a Double2D param takes two `double` varargs after the time.
+        // SAFETY: `h` is a Double2D param (checked by `typed`), which
+        // takes two `double` varargs after the time.
         check(unsafe { f(h, time, x, y) }, &format!("setting {id}"))
     }
 
     /// Sets a Double2D param's value (a param without keys).
     pub fn set_point(&self, id: &str, (x, y): (f64, f64)) -> Outcome {
+        let h = self.typed(id, Values::TwoDoubles)?;
         let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
-        let h = self.handle(id)?;
-        // SAFETY: a Double2D param takes two `double` varargs.
+        // SAFETY: `h` is a Double2D param (checked by `typed`), which
+        // takes two `double` varargs.
         check(unsafe { f(h, x, y) }, &format!("setting {id}"))
     }
 
     /// Sets an Integer, Boolean or Choice param's value.
     pub fn set_int(&self, id: &str, v: i32) -> Outcome {
+        let h = self.typed(id, Values::OneInt)?;
         let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
-        let h = self.handle(id)?;
-        // SAFETY: Integer, Boolean and Choice params take one `int` vararg.
+        // SAFETY: `h` is an Integer, Boolean or Choice param (checked by
+        // `typed`), which take one `int` vararg.
         check(unsafe { f(h, v as c_int) }, &format!("setting {id}"))
     }
 
@@ -417,9 +551,10 @@ impl Params {
     }
 
     pub fn string(&self, id: &str, time: f64) -> Outcome<String> {
-        let (h, f) = self.get_at(id)?;
+        let (h, f) = self.get_at(id, Values::OneString)?;
         let mut v: *const c_char = std::ptr::null();
-        // SAFETY: a String param takes one `char**` vararg; the host owns the result.
+        // SAFETY: `h` is a String param (checked by `typed`), which takes
+        // one `char**` vararg; the host owns the result.
         let status = unsafe { f(h, time, &mut v as *mut *const c_char) };
         check(status, &format!("reading {id}"))?;
         if v.is_null() {
@@ -427,5 +562,51 @@ impl Params {
         }
         // SAFETY: NUL-terminated host string, valid until the next param call; copied now.
         Ok(unsafe { CStr::from_ptr(v) }.to_string_lossy().into_owned())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TYPES: [ParamType; 7] = [
+        ParamType::Double,
+        ParamType::Double2D,
+        ParamType::Integer,
+        ParamType::Boolean,
+        ParamType::Choice,
+        ParamType::String,
+        ParamType::Other,
+    ];
+
+    #[test]
+    fn each_accessor_takes_exactly_the_types_the_param_suite_gives_its_values() {
+        use ParamType::*;
+        let takes =
+            |v: Values| -> Vec<ParamType> { TYPES.into_iter().filter(|t| v.fit(*t)).collect() };
+        // The OFX param suite: "double" for Double, two for Double2D, "int"
+        // for Integer, Boolean and Choice, "char*" for String.
+        assert_eq!(takes(Values::OneDouble), [Double]);
+        assert_eq!(takes(Values::TwoDoubles), [Double2D]);
+        assert_eq!(takes(Values::OneInt), [Integer, Boolean, Choice]);
+        assert_eq!(takes(Values::OneString), [String]);
+    }
+
+    #[test]
+    fn host_type_names_are_read_as_the_spec_spells_them() {
+        for (name, t) in [
+            (kOfxParamTypeDouble, ParamType::Double),
+            (kOfxParamTypeDouble2D, ParamType::Double2D),
+            (kOfxParamTypeInteger, ParamType::Integer),
+            (kOfxParamTypeBoolean, ParamType::Boolean),
+            (kOfxParamTypeChoice, ParamType::Choice),
+            (kOfxParamTypeString, ParamType::String),
+            (kOfxParamTypeDouble3D, ParamType::Other),
+            (kOfxParamTypeInteger2D, ParamType::Other),
+            (kOfxParamTypePushButton, ParamType::Other),
+        ] {
+            assert_eq!(ParamType::named(&name.to_string_lossy()), t, "{name:?}");
+        }
+        assert_eq!(ParamType::named(""), ParamType::Other);
     }
 }
