@@ -1,7 +1,7 @@
 //! The in-between image: both sources warped toward the same feature positions
 //! and dissolved (Beier-Neely §3.4).
 
-use crate::image::bilinear_rgba::{blend_row, Taps};
+use crate::image::bilinear_rgba::blend_row;
 use crate::image::resample::{adapt_channels, fill_rows, map_span, row_through};
 use crate::image::WarpMap;
 use crate::image::{Plane, RowsMut, Sample, Sampler};
@@ -93,11 +93,10 @@ pub fn dissolve<S: Sample, D: Sample>(
     // Both sources float RGBA through maps (the usual host plates), both
     // read: sampled and blended pixel by pixel in one pass.
     let direct = match (a, b) {
-        (Warped::Map(sa, ma), Warped::Map(sb, mb)) if dc == 4 && wa != 0.0 && wb != 0.0 => {
-            Taps::of(sa)
-                .zip(Taps::of(sb))
-                .map(|(ta, tb)| [(ta, sa, ma), (tb, sb, mb)])
-        }
+        (Warped::Map(sa, ma), Warped::Map(sb, mb)) if dc == 4 && wa != 0.0 && wb != 0.0 => sa
+            .direct_taps()
+            .zip(sb.direct_taps())
+            .map(|(ta, tb)| [(ta, sa, ma), (tb, sb, mb)]),
         _ => None,
     };
     fill_rows(dst, dc, |j, x1, row, other| {

@@ -18,7 +18,7 @@ use libdeflater::{CompressionLvl, Compressor};
 use rayon::prelude::*;
 
 use crate::host::HostError;
-use crate::io::{ExrPrecision, Plate};
+use crate::plate::{rgba, ExrPrecision, Plate};
 
 /// The `compression` attribute's values for the two ZIP flavours.
 const ZIPS: u8 = 2;
@@ -155,7 +155,7 @@ fn block(plate: &Plate, rows: std::ops::Range<usize>, precision: ExrPrecision) -
                 }
             } else {
                 for (d, px) in lane.iter_mut().zip(line.chunks_exact(c)) {
-                    *d = crate::io::rgba(px)[channel];
+                    *d = rgba(px)[channel];
                 }
             }
             match precision {

@@ -14,30 +14,8 @@ use morphfx::image::Image;
 use rayon::prelude::*;
 
 use crate::host::HostError;
-
-/// A plate: pixels in canonical coordinates (bottom-up) plus the frame it sits in.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Plate {
-    pub image: Image,
-    /// Width and height of the display window (the canonical frame).
-    pub size: (usize, usize),
-    /// Where the display window's top-left corner lies in the file's own
-    /// pixel coordinates (EXR: y grows downwards); 0,0 but in EXRs that say
-    /// otherwise. Canonical coordinates start at the window's bottom-left
-    /// whatever this is, so it only travels from input to output.
-    pub origin: (i32, i32),
-}
-
-impl Plate {
-    /// A plate whose display window starts at the file's origin.
-    pub fn new(image: Image, size: (usize, usize)) -> Plate {
-        Plate {
-            image,
-            size,
-            origin: (0, 0),
-        }
-    }
-}
+use crate::plate::rgba;
+pub use crate::plate::{ExrPrecision, Plate};
 
 /// An image file's display window, from its header.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -359,14 +337,6 @@ fn read_other(path: &Path, colour: Colour) -> std::result::Result<Plate, HostErr
     Ok(Plate::new(image, (w, h)))
 }
 
-/// Output sample type of EXR files.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ExrPrecision {
-    #[default]
-    Float,
-    Half,
-}
-
 /// How an output file is written.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OutputFormat {
@@ -473,18 +443,6 @@ fn rgba_at(plate: &Plate, x: usize, row_from_top: usize) -> [f32; 4] {
     let (w, h, c) = (img.width(), img.height(), img.channels);
     let k = ((h - 1 - row_from_top) * w + x) * c;
     rgba(&img.data[k..k + c])
-}
-
-/// A pixel of 1 to 4 channels as RGBA, the way every writer stores it: one
-/// channel in all four, grey and alpha, RGB opaque.
-pub(crate) fn rgba(px: &[f32]) -> [f32; 4] {
-    match *px {
-        [v] => [v; 4],
-        [g, a] => [g, g, g, a],
-        [r, g, b] => [r, g, b, 1.0],
-        [r, g, b, a, ..] => [r, g, b, a],
-        [] => [0.0; 4],
-    }
 }
 
 fn write_exr(

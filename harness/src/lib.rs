@@ -6,6 +6,7 @@ pub mod host;
 pub mod interrupt;
 pub mod io;
 pub mod pipeline;
+pub mod plate;
 pub mod progress;
 pub mod raster;
 pub mod sequence;

@@ -14,8 +14,14 @@
 
 use wide::{f32x8, i32x8};
 
-use super::sample::SNAP;
-use super::{Filter, Sample, Sampler};
+use super::Layout;
+use crate::geom::{PixelScale, RectI};
+
+/// Fractions this close to a pixel centre snap to it, so warps that land on
+/// centres up to float round-off copy pixels exactly instead of blurring.
+/// The general sampler snaps by the same bound, and positions this kernel
+/// leaves to it are those it would snap.
+pub(crate) const SNAP: f32 = 1e-4;
 
 /// A source sampled by direct addressing; see [`Taps::of`].
 #[derive(Clone, Copy)]
@@ -48,16 +54,16 @@ struct Located {
 }
 
 impl<'a> Taps<'a> {
-    /// Direct taps for a bilinear, premultiplied float RGBA sampler; `None`
-    /// for any other kind, which takes the general path.
-    pub(crate) fn of<T: Sample>(sampler: &Sampler<'a, T>) -> Option<Self> {
-        let view = sampler.view();
-        if sampler.filter() != Filter::Bilinear || view.channels() != 4 || sampler.alpha_weighted()
-        {
-            return None;
-        }
-        let data = T::as_f32(view.data)?;
-        let (b, layout, scale) = (view.bounds(), view.layout, sampler.scale());
+    /// Direct taps into premultiplied RGBA floats `data` laid out as
+    /// `layout`, covering pixels `b` at `scale` (see
+    /// [`super::Sampler::direct_taps`]); `None` for a buffer too large to
+    /// address in `i32`.
+    pub(crate) fn new(
+        data: &'a [f32],
+        b: RectI,
+        layout: Layout,
+        scale: PixelScale,
+    ) -> Option<Self> {
         if data.len() > i32::MAX as usize || layout.row_stride.unsigned_abs() > i32::MAX as usize {
             return None;
         }

@@ -3,7 +3,7 @@
 
 use wide::f32x8;
 
-use super::bilinear_rgba::{self, Taps};
+use super::bilinear_rgba::{self, Taps, SNAP};
 use super::{ImageView, Sample};
 use crate::choice::Choice;
 use crate::geom::{PixelScale, RectI};
@@ -72,10 +72,6 @@ impl EdgeMode {
     }
 }
 
-/// Fractions this close to a pixel centre snap to it, so warps that land on
-/// centres up to float round-off copy pixels exactly instead of blurring.
-pub(crate) const SNAP: f32 = 1e-4;
-
 /// Samples one image; at most 4 channels.
 #[derive(Debug, Clone, Copy)]
 pub struct Sampler<'a, T> {
@@ -115,11 +111,6 @@ impl<'a, T: Sample> Sampler<'a, T> {
         self.view.channels()
     }
 
-    #[inline]
-    pub(crate) fn view(&self) -> ImageView<'a, T> {
-        self.view
-    }
-
     /// The reconstruction filter.
     #[inline]
     pub fn filter(&self) -> Filter {
@@ -142,6 +133,17 @@ impl<'a, T: Sample> Sampler<'a, T> {
     #[inline]
     pub fn edge(&self) -> EdgeMode {
         self.edge
+    }
+
+    /// Direct taps for the bilinear kernel of premultiplied float RGBA
+    /// ([`bilinear_rgba`]); `None` for any other kind of source, which
+    /// takes the general path.
+    pub(crate) fn direct_taps(&self) -> Option<Taps<'a>> {
+        if self.filter != Filter::Bilinear || self.view.channels() != 4 || self.alpha_weighted {
+            return None;
+        }
+        let data = T::as_f32(self.view.data)?;
+        Taps::new(data, self.view.bounds(), self.view.layout, self.scale())
     }
 
     /// Whether colour is weighted by alpha while filtering (straight RGBA).
@@ -242,7 +244,7 @@ impl<'a, T: Sample> Sampler<'a, T> {
         match (self.view.channels(), self.alpha_weighted, cubic) {
             (4, true, false) => self.row::<4, true, false>(positions, out),
             (4, true, true) => self.row::<4, true, true>(positions, out),
-            (4, false, false) => match Taps::of(self) {
+            (4, false, false) => match self.direct_taps() {
                 Some(taps) => bilinear_rgba::row(&taps, positions, out, |n, o| {
                     self.sample(positions[n][0], positions[n][1], o)
                 }),

@@ -2,6 +2,7 @@
 //! queried for the features and the progress at any frame.
 
 mod parse;
+mod range;
 mod scattered;
 #[cfg(test)]
 mod tests;

@@ -4,6 +4,7 @@
 use serde::Deserialize;
 use serde_json::{Map, Value};
 
+use super::range::in_range;
 use super::{Keyframe, Scene};
 use crate::choice::Choice;
 use crate::error::{Error, Result};
@@ -224,24 +225,6 @@ fn samples_per_segment(sampling: Option<&RawSampling>) -> Result<usize> {
         )),
         Some(s) => Ok(s.samples_per_segment),
         None => Ok(crate::features::DEFAULT_SAMPLES_PER_SEGMENT),
-    }
-}
-
-/// `v` (`default` when absent) if it lies in `range` (NaN never does), else
-/// the error that names `at` and the range.
-pub(super) fn in_range<T: PartialOrd + Copy + std::fmt::Display>(
-    v: Option<T>,
-    default: T,
-    range: std::ops::RangeInclusive<T>,
-    at: &str,
-) -> Result<T> {
-    match v {
-        None => Ok(default),
-        Some(x) if range.contains(&x) => Ok(x),
-        Some(x) => Err(Error::scene(
-            at,
-            format!("{x} is out of range: {} to {}", range.start(), range.end()),
-        )),
     }
 }
 

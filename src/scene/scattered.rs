@@ -5,7 +5,7 @@ use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::{Map, Value};
 
-use super::parse::in_range;
+use super::range::in_range;
 use crate::bspline::mba::MbaSettings;
 use crate::choice::Choice;
 use crate::error::{Error, Result};

@@ -1,7 +1,6 @@
 //! Galerkin coarse levels: node classes whose rows are alike, springs
 //! restricted to the coarse grid, and the B-spline subdivision weights.
 
-use super::stencil::Stencil;
 use wide::f64x4;
 
 /// Nodes whose operator rows can differ only by how near they are to the
@@ -50,31 +49,6 @@ impl Classes {
         } else {
             n + c - 2 * m - 1
         }
-    }
-
-    /// A stencil whose rows are `row(i, j)` of one representative node per
-    /// class, computed in parallel.
-    pub(super) fn stencil(
-        &self,
-        side: usize,
-        row: impl Fn(usize, usize) -> Vec<f64> + Sync,
-    ) -> Stencil {
-        use rayon::prelude::*;
-        let (nx, ny) = (self.nx, self.ny);
-        let kx = self.count(nx);
-        let rows: Vec<f64> = (0..kx * self.count(ny))
-            .into_par_iter()
-            .flat_map_iter(|c| {
-                row(
-                    self.representative(c % kx, nx),
-                    self.representative(c / kx, ny),
-                )
-            })
-            .collect();
-        let index = (0..nx * ny)
-            .map(|n| (self.of(n / nx, ny) * kx + self.of(n % nx, nx)) as u32)
-            .collect();
-        Stencil::new(nx, ny, side, rows, index)
     }
 }
 

@@ -30,6 +30,31 @@ pub struct Stencil {
 }
 
 impl Stencil {
+    /// A stencil whose rows are `row(i, j)` of one representative node per
+    /// class of `classes`, computed in parallel.
+    fn by_class(
+        classes: &Classes,
+        side: usize,
+        row: impl Fn(usize, usize) -> Vec<f64> + Sync,
+    ) -> Stencil {
+        use rayon::prelude::*;
+        let (nx, ny) = (classes.nx, classes.ny);
+        let kx = classes.count(nx);
+        let rows: Vec<f64> = (0..kx * classes.count(ny))
+            .into_par_iter()
+            .flat_map_iter(|c| {
+                row(
+                    classes.representative(c % kx, nx),
+                    classes.representative(c / kx, ny),
+                )
+            })
+            .collect();
+        let index = (0..nx * ny)
+            .map(|n| (classes.of(n / nx, ny) * kx + classes.of(n % nx, nx)) as u32)
+            .collect();
+        Stencil::new(nx, ny, side, rows, index)
+    }
+
     pub(super) fn new(
         nx: usize,
         ny: usize,
@@ -218,7 +243,7 @@ impl Stencil {
     pub(super) fn bending(plate: &Plate) -> (Stencil, Classes) {
         let bare = Plate::new(plate.nx, plate.ny, plate.h, plate.alpha, plate.beta, &[]);
         let classes = Classes::new(plate.nx, plate.ny, 2);
-        let stencil = classes.stencil(5, |i, j| {
+        let stencil = Stencil::by_class(&classes, 5, |i, j| {
             probe_row(&bare, &mut vec![0.0; bare.nx * bare.ny], i, j).to_vec()
         });
         (stencil, classes)
@@ -236,7 +261,8 @@ impl Stencil {
         // 1`, likewise from the other end. This settles at 3.
         let margin = (fine.margin + 2).max(self.side / 2 + 3).div_ceil(2);
         let classes = Classes::new(cx, cy, margin);
-        let stencil = classes.stencil(7, |i, j| self.galerkin_row(i, j, cx, cy).to_vec());
+        let stencil =
+            Stencil::by_class(&classes, 7, |i, j| self.galerkin_row(i, j, cx, cy).to_vec());
         (stencil, classes)
     }
 
