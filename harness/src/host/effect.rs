@@ -418,7 +418,7 @@ unsafe extern "C" fn clip_release_image(image: OfxPropertySetHandle) -> OfxStatu
         // and are never freed (see below), so the set is live.
         let set = unsafe { &*(image as *const PropertySet) };
         if set.released.swap(true, Ordering::Relaxed) {
-            super::violation("an image released twice".into());
+            super::checks::violation("an image released twice".into());
             return kOfxStatErrBadHandle;
         }
         // The pixels go now; the emptied set stays, so a later use is reported

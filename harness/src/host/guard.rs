@@ -36,7 +36,7 @@ pub fn guard<R>(on_panic: R, name: &'static str, body: impl FnOnce() -> R) -> R 
                 .map(String::as_str)
                 .or_else(|| e.downcast_ref::<&str>().copied())
                 .unwrap_or("a panic");
-            super::host_failure(format!("host callback {name} panicked: {why}"));
+            super::checks::host_failure(format!("host callback {name} panicked: {why}"));
             on_panic
         }
     }

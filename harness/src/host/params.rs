@@ -420,7 +420,7 @@ fn check_write_allowed(param: &str) {
         )
     );
     if !allowed {
-        super::violation(format!(
+        super::checks::violation(format!(
             "param {param} written in {} (only the instance-changed action may set values)",
             action.as_deref().unwrap_or("a thread outside any action")
         ));
@@ -446,7 +446,7 @@ unsafe extern "C" fn edit(_: OfxParamSetHandle) -> OfxStatus {
             open
         });
         if !open {
-            super::violation("paramEditEnd without a paramEditBegin".into());
+            super::checks::violation("paramEditEnd without a paramEditBegin".into());
             return kOfxStatFailed;
         }
         log_edit("end".into());

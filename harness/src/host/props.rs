@@ -111,7 +111,9 @@ unsafe fn set_of<'a>(h: OfxPropertySetHandle) -> Option<&'a PropertySet> {
     // images' sets are kept).
     let set = unsafe { (h as *const PropertySet).as_ref() }?;
     if set.released.load(std::sync::atomic::Ordering::Relaxed) {
-        super::violation("an image's properties read or written after clipReleaseImage".into());
+        super::checks::violation(
+            "an image's properties read or written after clipReleaseImage".into(),
+        );
         return None;
     }
     Some(set)
