@@ -380,7 +380,7 @@ fn the_output_is_declared_frame_varying_and_premultiplied() {
     assert_eq!(prefs.ints(kOfxImageEffectFrameVarying), vec![1]);
     assert_eq!(
         prefs.strs(kOfxImageEffectPropPreMultiplication),
-        vec!["OfxImagePreMultiplied".to_owned()]
+        vec!["OfxImageAlphaPremultiplied".to_owned()]
     );
 }
 

@@ -80,7 +80,7 @@ fn interface_actions(inst: &Instance) -> Vec<(&'static std::ffi::CStr, PropertyS
     prefs_out.set_int(kOfxImageEffectFrameVarying, &[0]);
     prefs_out.set_str(
         kOfxImageEffectPropPreMultiplication,
-        "OfxImagePreMultiplied",
+        "OfxImageAlphaPremultiplied",
     );
     let frames_in = PropertySet::new();
     frames_in.set_double(kOfxPropTime, &[0.0]);

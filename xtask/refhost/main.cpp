@@ -438,6 +438,23 @@ void checkFailureMessage(Effect &fx, const Where &w) {
   file->set("");
 }
 
+/// Straight (unpremultiplied) sources, as the library names them
+/// (`kOfxImageUnPreMultiplied`): the node keeps its output straight, and
+/// says so in the clip preferences in the spec's words.
+void checkStraight(IE::ImageEffectPlugin &plugin, const std::string &context,
+                   const Where &where) {
+  const Where w = where.with(context).with("straight sources");
+  std::unique_ptr<IE::Instance> made(plugin.createInstance(context, nullptr));
+  auto *fx = dynamic_cast<Effect *>(made.get());
+  if (!fx) return fail(w.text + ": no instance (describe in context failed)");
+  fx->straight = true;
+  expectOk(fx->createInstanceAction(), w, "createInstance");
+  if (!fx->getClipPreferences()) return fail(w.text + ": getClipPreferences failed");
+  if (fx->getOutputPreMultiplication() != kOfxImageUnPreMultiplied)
+    fail(w.text + ": output declared '" + fx->getOutputPreMultiplication() + "', not '" +
+         kOfxImageUnPreMultiplied + "'");
+}
+
 /// A node just made, nothing connected, as Natron asks of it at once:
 /// region of definition, clip preferences, regions of interest, frames
 /// needed and identity each answer without a failure status, and nothing
@@ -548,6 +565,7 @@ int main(int argc, char **argv) {
         continue;
       }
       checkUnconnected(*plugin, context, {node.id});
+      checkStraight(*plugin, context, {node.id});
       for (const char *depth : {kOfxBitDepthFloat, kOfxBitDepthByte}) {
         checkContext(*plugin, context, depth, {node.id});
         ++checked;

@@ -367,7 +367,8 @@ const std::string &Clip::getUnmappedComponents() const {
 }
 const std::string &Clip::getPremult() const {
   static const std::string premult = kOfxImagePreMultiplied;
-  return premult;
+  static const std::string straight = kOfxImageUnPreMultiplied;
+  return effect_->straight ? straight : premult;
 }
 double Clip::getAspectRatio() const { return 1.0; }
 double Clip::getFrameRate() const { return 24.0; }

@@ -273,13 +273,14 @@ impl Frame {
         );
         p.set_str(
             kOfxImageEffectPropPreMultiplication,
-            if self.channels == 4 && !self.premultiplied {
-                "OfxImageUnPreMultiplied"
+            &if self.channels == 4 && !self.premultiplied {
+                kOfxImageUnPreMultiplied
             } else if self.channels == 3 {
-                "OfxImageOpaque"
+                kOfxImageOpaque
             } else {
-                "OfxImagePreMultiplied"
-            },
+                kOfxImagePreMultiplied
+            }
+            .to_string_lossy(),
         );
         p.set_double(kOfxImagePropPixelAspectRatio, &[self.par]);
         p.set_double(kOfxImageEffectPropRenderScale, &[scale.0, scale.1]);

@@ -437,7 +437,7 @@ impl Instance<'_> {
         out.set_int(kOfxImageEffectFrameVarying, &[0]);
         out.set_str(
             kOfxImageEffectPropPreMultiplication,
-            "OfxImagePreMultiplied",
+            &kOfxImagePreMultiplied.to_string_lossy(),
         );
         self.act(kOfxImageEffectActionGetClipPreferences, None, Some(&out))?;
         Ok(out)

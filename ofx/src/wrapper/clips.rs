@@ -393,7 +393,7 @@ fn image_info(p: &PropSet, clip: &str) -> Outcome<ImageInfo> {
         row_bytes: p.get_int(kOfxImagePropRowBytes, 0)? as isize,
         depth,
         channels,
-        premultiplied: premult != "OfxImageUnPreMultiplied",
+        premultiplied: premult.as_bytes() != kOfxImageUnPreMultiplied.to_bytes(),
         par: p
             .get_double(kOfxImagePropPixelAspectRatio, 0)
             .unwrap_or(1.0),

@@ -119,15 +119,19 @@ pub fn clip_preferences(kind: NodeKind, effect: &Effect, out_args: &PropSet) -> 
                 .props()?
                 .get_string(kOfxImageEffectPropPreMultiplication, 0)
                 .unwrap_or_default();
-            straight.push(state == "OfxImageUnPreMultiplied");
+            straight.push(state.as_bytes() == kOfxImageUnPreMultiplied.to_bytes());
         }
     }
     let output = if !straight.is_empty() && straight.iter().all(|s| *s) {
-        "OfxImageUnPreMultiplied"
+        kOfxImageUnPreMultiplied
     } else {
-        "OfxImagePreMultiplied"
+        kOfxImagePreMultiplied
     };
-    out_args.set_string(kOfxImageEffectPropPreMultiplication, 0, output)
+    out_args.set_string(
+        kOfxImageEffectPropPreMultiplication,
+        0,
+        &output.to_string_lossy(),
+    )
 }
 
 /// A warp can pull from anywhere: ask for each source's whole region, at the
