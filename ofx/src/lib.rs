@@ -1,11 +1,13 @@
 //! The MorphFX OpenFX plugin: Morph and Warp nodes over the `morphfx` core.
 //!
-//! `wrapper/` holds every line of FFI (exports, suites, property sets, params,
-//! clips and images, status mapping); `nodes/` is safe Rust: one file per
-//! node, params declared as data, render glue calling the core.
+//! `wrapper/` is the generic OpenFX layer, all of the FFI, naming no node;
+//! `nodes/` is safe Rust (`forbid(unsafe_code)`): the nodes as implementors
+//! of the layer's traits, params declared as data, render glue calling the
+//! core. This file is the composition root: the one place that names the
+//! bundle's nodes.
 
 mod cache;
 mod nodes;
 mod wrapper;
 
-pub use nodes::{PLUGIN_IDS, PLUGIN_VERSION};
+wrapper::export!(nodes::Morph, nodes::Warp);

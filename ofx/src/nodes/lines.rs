@@ -5,9 +5,9 @@ use morphfx::features::Side;
 use morphfx::geom::Vec2;
 
 use super::params::{slot_clear, slot_group, slot_ids, spec, Reader, LINE_COUNT, LINE_SLOTS};
-use super::spec::Kind;
 use super::NodeKind;
 use crate::wrapper::params::Params;
+use crate::wrapper::spec::Kind;
 use crate::wrapper::Outcome;
 
 /// One enabled slot's lines at a time: A's and B's, start then end.

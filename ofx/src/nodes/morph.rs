@@ -2,18 +2,30 @@
 //! dissolved. General context (SourceA, SourceB) and transition context
 //! (SourceFrom, SourceTo, progress from the host's Transition param).
 
-use super::NodeInfo;
+use std::ffi::CStr;
 
-pub const INFO: NodeInfo = NodeInfo {
-    id: "net.morphfx.Morph",
-    label: "MorphFX Morph",
-    description: "Feature-based morph (Beier-Neely field warping): warps A and B toward the in-between feature positions and dissolves them.",
-    contexts: &[c"OfxImageEffectContextGeneral", c"OfxImageEffectContextTransition"],
-};
+use super::{Node, NodeKind, NodeState};
+use crate::wrapper::plugin::Context;
+
+pub struct Morph(NodeState);
+
+impl Node for Morph {
+    const KIND: NodeKind = NodeKind::Morph;
+    const ID: &'static CStr = c"net.morphfx.Morph";
+    const LABEL: &'static str = "MorphFX Morph";
+    const DESCRIPTION: &'static str = "Feature-based morph (Beier-Neely field warping): warps A and B toward the in-between feature positions and dissolves them.";
+    const CONTEXTS: &'static [Context] = &[Context::General, Context::Transition];
+    fn new(state: NodeState) -> Self {
+        Morph(state)
+    }
+    fn state(&self) -> &NodeState {
+        &self.0
+    }
+}
 
 /// Clip names (A, B) in a context.
-pub fn source_clips(context: &str) -> [&'static str; 2] {
-    if context == "OfxImageEffectContextTransition" {
+pub fn source_clips(context: Context) -> [&'static str; 2] {
+    if context == Context::Transition {
         ["SourceFrom", "SourceTo"]
     } else {
         ["SourceA", "SourceB"]

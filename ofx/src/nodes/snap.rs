@@ -9,19 +9,18 @@ use morphfx::geom::{PixelScale, Vec2};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 
 use super::params::{slot_ids, Reader, Settings, LINE_COUNT, SNAP_SIGMA};
-use super::render::context;
-use super::{instance, NodeKind};
-use crate::wrapper::clips::{Depth, Effect};
+use super::NodeState;
+use crate::wrapper::clips::{Depth, EffectHandle};
 use crate::wrapper::{Failure, Outcome};
 
 /// The Snap Lines button, pressed at `time`.
-pub fn snap_lines(kind: NodeKind, effect: &Effect, time: f64) -> Outcome {
-    let instance = instance::get(effect)?;
-    let params = instance.params()?;
+pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Outcome {
+    let kind = instance.kind;
+    let params = instance.params();
     let settings = Settings::read(params, time, kind);
     let r = Reader::new(params, kind, time);
     let sigma = r.double(SNAP_SIGMA);
-    let (a, b) = kind.source_clips(&context(effect));
+    let (a, b) = kind.source_clips(instance.context);
     let energy_a = edge_energy(effect, a, time + settings.offset_a as f64, sigma)?;
     let energy_b = match b {
         Some(b) => Some(edge_energy(
@@ -79,7 +78,7 @@ fn snap_line(line: [Vec2; 2], energy: &EdgeEnergy, scale: PixelScale) -> [Vec2; 
 
 /// The edge energy of clip `name` at `time`, and the pixel scale it is in.
 fn edge_energy(
-    effect: &Effect,
+    effect: &EffectHandle,
     name: &str,
     time: f64,
     sigma: f64,

@@ -16,10 +16,10 @@ use morphfx::track::{Grey, Pyramid, SideTracker, TrackSettings};
 
 use super::lines::{end_id, slot_lines, SlotLine};
 use super::params::{Reader, Settings};
-use super::render::context;
-use super::{instance, NodeKind};
-use crate::wrapper::clips::{Depth, Effect};
+use super::{NodeKind, NodeState};
+use crate::wrapper::clips::{Depth, EffectHandle};
 use crate::wrapper::params::Params;
+use crate::wrapper::plugin::Context;
 use crate::wrapper::{Failure, Outcome};
 
 /// Frames tracked at most when neither keys nor the clip say where to stop.
@@ -36,7 +36,7 @@ struct Follower {
 
 /// A source clip and its frame offset, with the pixel scale of its images.
 struct Source<'e> {
-    effect: &'e Effect,
+    effect: &'e EffectHandle,
     clip: &'static str,
     offset: f64,
 }
@@ -60,14 +60,14 @@ impl Source<'_> {
 }
 
 /// A Track button pressed at `time`: `step` is 1 (forward) or -1.
-pub fn track_lines(kind: NodeKind, effect: &Effect, time: f64, step: i64) -> Outcome {
-    let instance = instance::get(effect)?;
-    let params = instance.params()?;
+pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step: i64) -> Outcome {
+    let kind = instance.kind;
+    let params = instance.params();
     let lines = slot_lines(&Reader::new(params, kind, time));
     if lines.is_empty() {
         return Ok(());
     }
-    let sources = sources(kind, effect, params, time)?;
+    let sources = sources((kind, instance.context), effect, params, time)?;
     let stop = stop_frame(params, effect, &sources, &lines, time, step);
     let settings = TrackSettings::default();
     let mut followers = Vec::new();
@@ -113,13 +113,13 @@ pub fn track_lines(kind: NodeKind, effect: &Effect, time: f64, step: i64) -> Out
 
 /// The node's sources with their sides and frame offsets, each connected.
 fn sources<'e>(
-    kind: NodeKind,
-    effect: &'e Effect,
+    (kind, context): (NodeKind, Context),
+    effect: &'e EffectHandle,
     params: &Params,
     time: f64,
 ) -> Outcome<Vec<(Side, Source<'e>)>> {
     let settings = Settings::read(params, time, kind);
-    let (a, b) = kind.source_clips(&context(effect));
+    let (a, b) = kind.source_clips(context);
     let mut out = vec![(Side::A, a, settings.offset_a)];
     out.extend(b.map(|b| (Side::B, b, settings.offset_b)));
     out.into_iter()
@@ -145,7 +145,7 @@ fn sources<'e>(
 /// `time`, else the clip's last (or first) frame.
 fn stop_frame(
     params: &Params,
-    effect: &Effect,
+    effect: &EffectHandle,
     sources: &[(Side, Source<'_>)],
     lines: &[SlotLine],
     time: f64,
@@ -184,7 +184,7 @@ fn stop_frame(
 
 /// Frames `time + step` to `stop`: track, key, report progress.
 fn sweep(
-    effect: &Effect,
+    effect: &EffectHandle,
     params: &Params,
     sources: &[(Side, Source<'_>)],
     followers: &mut [Follower],
@@ -224,7 +224,7 @@ fn sweep(
 }
 
 /// Names each line that lost track, and where.
-fn report_lost(effect: &Effect, followers: &[Follower]) {
+fn report_lost(effect: &EffectHandle, followers: &[Follower]) {
     let lost: Vec<String> = followers
         .iter()
         .filter_map(|f| {
@@ -234,8 +234,7 @@ fn report_lost(effect: &Effect, followers: &[Follower]) {
         })
         .collect();
     if !lost.is_empty() {
-        effect.message(
-            openfx::sys::image_effect_v1::message::kOfxMessageWarning,
+        effect.warning(
             c"net.morphfx.track.lost",
             &format!(
                 "Track lost {} (not keyed from there: key it by hand and track again): {}",

@@ -2,25 +2,26 @@
 
 use std::ffi::{c_void, CStr, CString};
 
-use morphfx::geom::RectI;
+use morphfx::geom::{RectD, RectI, Vec2};
 use morphfx::image::{ImageView, Layout, RowsMut, Sample};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 use openfx::sys::image_effect_v1::message::*;
 use openfx::sys::image_effect_v1::param::*;
 
+use super::context::Context;
 use super::host::{self, Suites};
 use super::params::ParamSet;
 use super::props::PropSet;
 use super::{check, Failure, Outcome};
 
 #[derive(Clone, Copy)]
-pub struct Effect {
+pub struct EffectHandle {
     handle: OfxImageEffectHandle,
     suites: Suites,
 }
 
-impl Effect {
+impl EffectHandle {
     /// The effect behind a host's handle.
     ///
     /// # Safety
@@ -35,13 +36,13 @@ impl Effect {
                 "null effect handle".into(),
             ));
         }
-        Ok(Effect {
+        Ok(EffectHandle {
             handle: handle as OfxImageEffectHandle,
             suites: host::suites()?,
         })
     }
 
-    pub fn props(&self) -> Outcome<PropSet> {
+    pub(super) fn props(&self) -> Outcome<PropSet> {
         let f = self
             .suites
             .effect
@@ -54,7 +55,26 @@ impl Effect {
         unsafe { PropSet::from_raw(p) }
     }
 
-    pub fn param_set(&self) -> Outcome<ParamSet> {
+    /// The context the host made the instance in.
+    pub fn context(&self) -> Outcome<Context> {
+        let name = self.props()?.get_string(kOfxImageEffectPropContext, 0)?;
+        Context::from_host(&name)
+    }
+
+    /// The project's images as (origin, size), canonical, when the host
+    /// says: the spec's project size placed at the project offset (the
+    /// extent is rooted at 0,0 and is not the size).
+    pub fn project(&self) -> Option<(Vec2, Vec2)> {
+        let p = self.props().ok()?;
+        let size = p.get_doubles::<2>(kOfxImageEffectPropProjectSize).ok()?;
+        let origin = p
+            .get_doubles::<2>(kOfxImageEffectPropProjectOffset)
+            .unwrap_or([0.0, 0.0]);
+        (size[0] > 0.0 && size[1] > 0.0)
+            .then(|| (Vec2::new(origin[0], origin[1]), Vec2::new(size[0], size[1])))
+    }
+
+    pub(super) fn param_set(&self) -> Outcome<ParamSet> {
         let f = self
             .suites
             .effect
@@ -67,7 +87,7 @@ impl Effect {
         unsafe { ParamSet::from_raw(p) }
     }
 
-    pub fn define_clip(&self, name: &str) -> Outcome<PropSet> {
+    pub(super) fn define_clip(&self, name: &str) -> Outcome<PropSet> {
         let f = self
             .suites
             .effect
@@ -145,7 +165,7 @@ impl Effect {
     }
 
     /// Posts a message through the host's message suite (if it has one).
-    pub fn message(&self, kind: &CStr, id: &CStr, text: &str) {
+    fn message(&self, kind: &CStr, id: &CStr, text: &str) {
         let Some(suite) = self.suites.message else {
             return;
         };
@@ -164,14 +184,19 @@ impl Effect {
         }
     }
 
-    pub fn error(&self, id: &CStr, text: &str) {
+    /// Posts a warning (message suite), once per call.
+    pub fn warning(&self, id: &CStr, text: &str) {
+        self.message(kOfxMessageWarning, id, text);
+    }
+
+    pub(super) fn error(&self, id: &CStr, text: &str) {
         self.message(kOfxMessageError, id, text);
     }
 
     /// Sets the node's persistent error (message suite v2), which stays on
-    /// the node until [`Effect::clear_persistent`]. False when the host has
+    /// the node until [`EffectHandle::clear_persistent`]. False when the host has
     /// no v2 suite (the caller then posts a transient message).
-    pub fn persistent_error(&self, id: &CStr, text: &str) -> bool {
+    pub(super) fn persistent_error(&self, id: &CStr, text: &str) -> bool {
         let Some(f) = self.suites.message_v2.and_then(|s| s.setPersistentMessage) else {
             return false;
         };
@@ -190,8 +215,8 @@ impl Effect {
         status == kOfxStatOK
     }
 
-    /// Clears the persistent message set by [`Effect::persistent_error`].
-    pub fn clear_persistent(&self) {
+    /// Clears the persistent message set by [`EffectHandle::persistent_error`].
+    pub(super) fn clear_persistent(&self) {
         if let Some(f) = self
             .suites
             .message_v2
@@ -211,7 +236,7 @@ pub struct Clip {
 }
 
 impl Clip {
-    pub fn props(&self) -> Outcome<PropSet> {
+    fn props(&self) -> Outcome<PropSet> {
         let f = self
             .suites
             .effect
@@ -231,6 +256,15 @@ impl Clip {
             .unwrap_or(false)
     }
 
+    /// Whether the clip's colour is straight, not premultiplied by its
+    /// alpha (`kOfxImageEffectPropPreMultiplication`); premultiplied where
+    /// the host does not say.
+    pub fn is_straight(&self) -> bool {
+        self.props()
+            .and_then(|p| p.get_string(kOfxImageEffectPropPreMultiplication, 0))
+            .is_ok_and(|s| s.as_bytes() == kOfxImageUnPreMultiplied.to_bytes())
+    }
+
     /// The frames the clip has images for (`kOfxImageEffectPropFrameRange`),
     /// when the host says.
     pub fn frame_range(&self) -> Option<(f64, f64)> {
@@ -243,7 +277,7 @@ impl Clip {
     }
 
     /// Region of definition at `time`, canonical coordinates.
-    pub fn rod(&self, time: f64) -> Outcome<OfxRectD> {
+    pub fn rod(&self, time: f64) -> Outcome<RectD> {
         let f = self
             .suites
             .effect
@@ -258,7 +292,7 @@ impl Clip {
         // SAFETY: clip handle from the host; out-pointer live.
         let status = unsafe { f(self.handle, time, &mut r) };
         check(status, &format!("RoD of clip {}", self.name))?;
-        Ok(r)
+        Ok(RectD::new(r.x1, r.y1, r.x2, r.y2))
     }
 
     /// The clip's image at `time`; `None` when the host has none (unconnected

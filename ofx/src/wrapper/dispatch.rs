@@ -1,19 +1,26 @@
-//! The one door every action comes through: null checks, unwinds caught,
-//! failures reported through the message suite and mapped to OFX statuses.
+//! The one door every action comes through, made per node type: null
+//! checks, unwinds caught, each action's arguments read into typed values,
+//! the node's answer written back, failures reported through the message
+//! suite and mapped to OFX statuses.
 
-use std::ffi::{c_char, c_void, CStr};
+use std::ffi::{c_char, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::Arc;
+use std::sync::atomic::Ordering;
 
+use morphfx::geom::{RectD, RectI};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 
-use super::clips::Effect;
+use super::attach::{attachment, create, detach};
+use super::clips::EffectHandle;
+use super::plugin::{
+    ChangeReason, ClipPreferences, Field, FrameArgs, FramesNeeded, ImageEffect, ParamChange,
+    RenderArgs, RoiArgs, Rois,
+};
 use super::props::PropSet;
-use super::{Failure, Outcome, Reply, BAD_INPUT_ID};
-use crate::nodes::{self, Instance, NodeKind};
+use super::{describe, host, Failure, Outcome, Reply, BAD_INPUT_ID};
 
-/// Runs `action` of a `kind` node and answers its status.
+/// The main entry point of node type `E` (`OfxPluginEntryPoint`).
 ///
 /// # Safety
 /// The arguments are an OFX main entry's, as the host passed them: `action`
@@ -21,8 +28,7 @@ use crate::nodes::{self, Instance, NodeKind};
 /// the action; `in_args` and `out_args` null or the action's property sets;
 /// all valid until this call returns (instance handles longer: until
 /// destroyInstance), which the OFX API promises of every host.
-pub unsafe fn dispatch(
-    kind: NodeKind,
+pub unsafe extern "C" fn main_entry<E: ImageEffect>(
     action: *const c_char,
     handle: *const c_void,
     in_args: OfxPropertySetHandle,
@@ -35,7 +41,7 @@ pub unsafe fn dispatch(
     let action = unsafe { CStr::from_ptr(action) };
     let effect = (!handle.is_null()).then(|| {
         // SAFETY: the action's effect handle, per this function's contract.
-        unsafe { Effect::from_raw(handle) }
+        unsafe { EffectHandle::from_raw(handle) }
     });
     let args = |p: OfxPropertySetHandle| {
         (!p.is_null()).then(|| {
@@ -45,7 +51,7 @@ pub unsafe fn dispatch(
     };
     let (in_args, out_args) = (args(in_args), args(out_args));
     let result = catch_unwind(AssertUnwindSafe(|| {
-        let forced = &super::host::switches().force_panic;
+        let forced = &host::switches().force_panic;
         if forced
             .as_ref()
             .is_some_and(|a| a.as_bytes() == action.to_bytes())
@@ -57,12 +63,12 @@ pub unsafe fn dispatch(
         }
         // Suites may be fetched from the load action on (not in setHost).
         if action == kOfxActionLoad {
-            return super::host::load().map(|()| Reply::Done);
+            return host::load().map(|()| Reply::Done);
         }
         let effect = effect.clone().transpose()?;
         let in_args = in_args.clone().transpose()?;
         let out_args = out_args.clone().transpose()?;
-        nodes::action(kind, action, effect, in_args, out_args)
+        run::<E>(action, effect, in_args, out_args)
     }));
     let effect = effect.and_then(Result::ok);
     match result {
@@ -91,6 +97,232 @@ pub unsafe fn dispatch(
     }
 }
 
+/// An action's argument set, or the error that says the host sent none.
+fn arg(args: Option<PropSet>, which: &str, action: &CStr) -> Outcome<PropSet> {
+    args.ok_or_else(|| {
+        Failure::Status(
+            kOfxStatErrBadHandle,
+            format!("{} without {which} arguments", action.to_string_lossy()),
+        )
+    })
+}
+
+/// Runs one action of an `E` node; [`Reply::Default`] for actions left to
+/// the host.
+fn run<E: ImageEffect>(
+    action: &CStr,
+    effect: Option<EffectHandle>,
+    in_args: Option<PropSet>,
+    out_args: Option<PropSet>,
+) -> Outcome<Reply> {
+    if action == kOfxActionUnload {
+        return Ok(Reply::Done);
+    }
+    let effect = effect.ok_or_else(|| {
+        Failure::Status(
+            kOfxStatErrBadHandle,
+            format!("{} without an effect handle", action.to_string_lossy()),
+        )
+    })?;
+    let in_props = || arg(in_args, "in", action);
+    let out_props = || arg(out_args, "out", action);
+    if action == kOfxActionDescribe {
+        describe::describe::<E>(&effect)?;
+    } else if action == kOfxImageEffectActionDescribeInContext {
+        describe::describe_in_context::<E>(&effect, &in_props()?)?;
+    } else if action == kOfxActionCreateInstance {
+        create::<E>(&effect)?;
+    } else if action == kOfxActionDestroyInstance {
+        detach(&effect)?;
+    } else if action == kOfxActionPurgeCaches {
+        attachment(&effect)?.node::<E>()?.purge();
+    } else if action == kOfxImageEffectActionGetRegionOfDefinition {
+        return region_of_definition::<E>(&effect, &in_props()?, &out_props()?);
+    } else if action == kOfxImageEffectActionGetRegionsOfInterest {
+        return regions_of_interest::<E>(&effect, &in_props()?, &out_props()?);
+    } else if action == kOfxImageEffectActionGetFramesNeeded {
+        return frames_needed::<E>(&effect, &in_props()?, &out_props()?);
+    } else if action == kOfxImageEffectActionGetClipPreferences {
+        return clip_preferences::<E>(&effect, &out_props()?);
+    } else if action == kOfxImageEffectActionIsIdentity {
+        return is_identity::<E>(&effect, &in_props()?, &out_props()?);
+    } else if action == kOfxImageEffectActionRender {
+        render::<E>(&effect, &in_props()?)?;
+    } else if action == kOfxActionInstanceChanged {
+        param_changed::<E>(&effect, &in_props()?)?;
+    } else {
+        return Ok(Reply::Default);
+    }
+    Ok(Reply::Done)
+}
+
+fn frame_args(in_args: &PropSet) -> Outcome<FrameArgs> {
+    Ok(FrameArgs {
+        time: in_args.get_double(kOfxPropTime, 0)?,
+        render_scale: render_scale(in_args),
+    })
+}
+
+/// The render scale an action carries, (1, 1) where the host sends none.
+fn render_scale(in_args: &PropSet) -> (f64, f64) {
+    match in_args.get_doubles::<2>(kOfxImageEffectPropRenderScale) {
+        Ok([x, y]) if x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite() => (x, y),
+        _ => (1.0, 1.0),
+    }
+}
+
+fn region_of_definition<E: ImageEffect>(
+    effect: &EffectHandle,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome<Reply> {
+    let args = frame_args(in_args)?;
+    let attached = attachment(effect)?;
+    let Some(r) = attached.node::<E>()?.region_of_definition(effect, &args)? else {
+        return Ok(Reply::Default);
+    };
+    out_args.set_doubles(
+        kOfxImageEffectPropRegionOfDefinition,
+        &[r.x1, r.y1, r.x2, r.y2],
+    )?;
+    Ok(Reply::Done)
+}
+
+fn regions_of_interest<E: ImageEffect>(
+    effect: &EffectHandle,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome<Reply> {
+    let [x1, y1, x2, y2] = in_args.get_doubles::<4>(kOfxImageEffectPropRegionOfInterest)?;
+    let args = RoiArgs {
+        time: in_args.get_double(kOfxPropTime, 0)?,
+        render_scale: render_scale(in_args),
+        region: RectD::new(x1, y1, x2, y2),
+    };
+    let mut rois = Rois::default();
+    let attached = attachment(effect)?;
+    let reply = attached
+        .node::<E>()?
+        .regions_of_interest(effect, &args, &mut rois)?;
+    for (clip, r) in rois.set {
+        let prop = CString::new(format!("OfxImageClipPropRoI_{clip}")).unwrap_or_default();
+        out_args.set_doubles(&prop, &[r.x1, r.y1, r.x2, r.y2])?;
+    }
+    Ok(reply)
+}
+
+fn frames_needed<E: ImageEffect>(
+    effect: &EffectHandle,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome<Reply> {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let mut needed = FramesNeeded::default();
+    let attached = attachment(effect)?;
+    let reply = attached
+        .node::<E>()?
+        .frames_needed(effect, time, &mut needed)?;
+    for (clip, (a, b)) in needed.set {
+        let prop = CString::new(format!("OfxImageClipPropFrameRange_{clip}")).unwrap_or_default();
+        out_args.set_doubles(&prop, &[a, b])?;
+    }
+    Ok(reply)
+}
+
+fn clip_preferences<E: ImageEffect>(effect: &EffectHandle, out_args: &PropSet) -> Outcome<Reply> {
+    let mut prefs = ClipPreferences::default();
+    let attached = attachment(effect)?;
+    let reply = attached.node::<E>()?.clip_preferences(effect, &mut prefs)?;
+    if let Some(varying) = prefs.frame_varying {
+        out_args.set_int(kOfxImageEffectFrameVarying, 0, varying as i32)?;
+    }
+    if let Some(premultiplied) = prefs.premultiplied_output {
+        let state = if premultiplied {
+            kOfxImagePreMultiplied
+        } else {
+            kOfxImageUnPreMultiplied
+        };
+        out_args.set_string(
+            kOfxImageEffectPropPreMultiplication,
+            0,
+            &state.to_string_lossy(),
+        )?;
+    }
+    Ok(reply)
+}
+
+/// A render's or an identity question's arguments.
+fn render_args(in_args: &PropSet) -> Outcome<RenderArgs> {
+    let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
+    let field = in_args
+        .get_string(kOfxImageEffectPropFieldToRender, 0)
+        .unwrap_or_default();
+    let field = if field.as_bytes() == kOfxImageFieldLower.to_bytes() {
+        Field::Lower
+    } else if field.as_bytes() == kOfxImageFieldUpper.to_bytes() {
+        Field::Upper
+    } else {
+        Field::Both
+    };
+    Ok(RenderArgs {
+        time: in_args.get_double(kOfxPropTime, 0)?,
+        window: RectI::new(x1, y1, x2, y2),
+        render_scale: render_scale(in_args),
+        field,
+        sequential: in_args
+            .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
+            .unwrap_or(0)
+            == 1,
+    })
+}
+
+fn is_identity<E: ImageEffect>(
+    effect: &EffectHandle,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome<Reply> {
+    let args = render_args(in_args)?;
+    let attached = attachment(effect)?;
+    let Some(identity) = attached.node::<E>()?.is_identity(effect, &args)? else {
+        return Ok(Reply::Default);
+    };
+    out_args.set_string(kOfxPropName, 0, identity.clip)?;
+    out_args.set_double(kOfxPropTime, 0, identity.time)?;
+    Ok(Reply::Done)
+}
+
+fn render<E: ImageEffect>(effect: &EffectHandle, in_args: &PropSet) -> Outcome {
+    let args = render_args(in_args)?;
+    let attached = attachment(effect)?;
+    attached.node::<E>()?.render(effect, &args)?;
+    // A good render clears the persistent error a failed one left.
+    if attached.error_shown.swap(false, Ordering::AcqRel) {
+        effect.clear_persistent();
+    }
+    Ok(())
+}
+
+fn param_changed<E: ImageEffect>(effect: &EffectHandle, in_args: &PropSet) -> Outcome {
+    let name = in_args.get_string(kOfxPropName, 0)?;
+    let reason = in_args
+        .get_string(kOfxPropChangeReason, 0)
+        .unwrap_or_default();
+    let reason = if reason.as_bytes() == kOfxChangeUserEdited.to_bytes() {
+        ChangeReason::User
+    } else if reason.as_bytes() == kOfxChangePluginEdited.to_bytes() {
+        ChangeReason::Plugin
+    } else {
+        ChangeReason::Other
+    };
+    let change = ParamChange {
+        name,
+        time: in_args.get_double(kOfxPropTime, 0)?,
+        reason,
+    };
+    let attached = attachment(effect)?;
+    attached.node::<E>()?.param_changed(effect, &change)
+}
+
 /// Actions a host runs on render threads (or may): their failures go to the
 /// node's persistent message, since a transient one becomes a modal dialog
 /// per frame and thread in some hosts (Natron).
@@ -104,7 +336,7 @@ const RENDER_TIME: [&CStr; 7] = [
     kOfxImageEffectActionEndSequenceRender,
 ];
 
-fn report(effect: Option<&Effect>, action: &CStr, failure: &Failure) {
+fn report(effect: Option<&EffectHandle>, action: &CStr, failure: &Failure) {
     let id = match failure {
         Failure::BadInput(_) => BAD_INPUT_ID,
         _ => c"net.morphfx.Error",
@@ -114,76 +346,16 @@ fn report(effect: Option<&Effect>, action: &CStr, failure: &Failure) {
         Some(effect) => effect,
         None => {
             let text = format!("{}: {text}", action.to_string_lossy());
-            return super::host::unowned_error(id, &text);
+            return host::unowned_error(id, &text);
         }
     };
     if RENDER_TIME.contains(&action) {
-        if let Ok(instance) = instance(effect) {
+        if let Ok(attached) = attachment(effect) {
             if effect.persistent_error(id, text) {
-                instance
-                    .error_shown
-                    .store(true, std::sync::atomic::Ordering::Release);
+                attached.error_shown.store(true, Ordering::Release);
                 return;
             }
         }
     }
     effect.error(id, text);
-}
-
-/// After a good render: clears the persistent error a failed one left.
-pub fn render_succeeded(effect: &Effect) {
-    if let Ok(instance) = instance(effect) {
-        if instance
-            .error_shown
-            .swap(false, std::sync::atomic::Ordering::AcqRel)
-        {
-            effect.clear_persistent();
-        }
-    }
-}
-
-/// Stores `instance` in the effect's instance data (created in createInstance).
-pub fn attach_instance(effect: &Effect, instance: Arc<Instance>) -> Outcome {
-    let raw = Arc::into_raw(instance) as *mut c_void;
-    effect
-        .props()?
-        .set_pointer(kOfxPropInstanceData, 0, raw)
-        .inspect_err(|_| {
-            // SAFETY: `raw` came from Arc::into_raw just above and was not stored.
-            drop(unsafe { Arc::from_raw(raw as *const Instance) });
-        })
-}
-
-/// Takes the instance data back and drops our reference (destroyInstance).
-pub fn detach_instance(effect: &Effect) -> Outcome {
-    let props = effect.props()?;
-    let raw = props.get_pointer(kOfxPropInstanceData, 0)?;
-    if raw.is_null() {
-        return Ok(());
-    }
-    props.set_pointer(kOfxPropInstanceData, 0, std::ptr::null_mut())?;
-    // SAFETY: a non-null instance pointer is only ever one made by
-    // `attach_instance` from Arc::into_raw; it is cleared above so this is its
-    // only release. Renders still running hold their own clones.
-    drop(unsafe { Arc::from_raw(raw as *const Instance) });
-    Ok(())
-}
-
-/// The instance's state, as a reference-counted handle that stays valid even
-/// if the host destroys the instance while this call runs.
-pub fn instance(effect: &Effect) -> Outcome<Arc<Instance>> {
-    let raw = effect.props()?.get_pointer(kOfxPropInstanceData, 0)?;
-    if raw.is_null() {
-        return Err(Failure::Failed(
-            "instance has no data: createInstance was not called".into(),
-        ));
-    }
-    let raw = raw as *const Instance;
-    // SAFETY: `raw` came from Arc::into_raw in `attach_instance` and the
-    // attachment's count is still held (it is cleared before release), so
-    // taking one more strong count and materialising it is sound.
-    unsafe {
-        Arc::increment_strong_count(raw);
-        Ok(Arc::from_raw(raw))
-    }
 }

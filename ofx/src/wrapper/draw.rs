@@ -7,7 +7,7 @@ use openfx::sys::generic::core::OfxPointD;
 use openfx::sys::image_effect_v1::draw_suite::*;
 use openfx::sys::image_effect_v1::pixels::OfxRGBAColourF;
 
-use crate::nodes::overlay::paint::{Painter, Stipple};
+use super::paint::{Painter, Stipple};
 
 /// Draws through the host's Draw suite into one draw action's context.
 pub struct DrawSuitePainter {

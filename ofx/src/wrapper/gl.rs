@@ -12,7 +12,7 @@ use std::sync::OnceLock;
 use morphfx::geom::Vec2;
 use morphfx::strokes;
 
-use crate::nodes::overlay::paint::{Painter, Stipple, LABEL_PX};
+use super::paint::{Painter, Stipple, LABEL_PX};
 
 type GLenum = c_uint;
 

@@ -183,3 +183,8 @@ pub fn suites() -> Outcome<Suites> {
         .unwrap_or_else(|e| e.into_inner())
         .ok_or_else(|| Failure::Failed("the host never sent the load action".into()))
 }
+
+/// `MORPHFX_VERBOSE` is set: solvers say what they did on stderr.
+pub fn verbose() -> bool {
+    switches().verbose
+}

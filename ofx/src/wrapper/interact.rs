@@ -1,7 +1,8 @@
-//! The overlay interact's entry points: the same door discipline as
-//! [`super::dispatch`] (null checks, unwinds caught, statuses mapped), the
-//! host's interact arguments read into safe values, and the painter chosen:
-//! the Draw suite when the draw action carries a context, else OpenGL.
+//! The overlay interact's entry point, made per node type: the same door
+//! discipline as [`super::dispatch`] (null checks, unwinds caught, statuses
+//! mapped), the host's interact arguments read into typed values, and the
+//! painter chosen: the Draw suite when the draw action carries a context,
+//! else OpenGL.
 
 use std::ffi::{c_char, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -12,42 +13,22 @@ use openfx::sys::image_effect_v1::draw_suite::*;
 use openfx::sys::image_effect_v1::interact::*;
 use openfx::sys::image_effect_v1::key_syms::kOfxPropKeySym;
 
-use super::clips::Effect;
+use super::attach::attachment;
+use super::clips::EffectHandle;
 use super::draw::DrawSuitePainter;
 use super::gl::GlPainter;
+use super::plugin::{DrawArgs, ImageEffect, Overlay, Pen};
 use super::props::PropSet;
 use super::{host, Failure, Outcome, Reply};
-use crate::nodes::overlay::{self, Pen};
-use crate::nodes::NodeKind;
 
-entry_point!(morph_overlay, NodeKind::Morph, dispatch);
-entry_point!(warp_overlay, NodeKind::Warp, dispatch);
-
-/// The overlay entry point of a `kind` node, for the effect descriptor.
-pub fn entry(kind: NodeKind) -> *mut c_void {
-    let f: OfxPluginEntryPoint = match kind {
-        NodeKind::Morph => morph_overlay,
-        NodeKind::Warp => warp_overlay,
-    };
-    f as *mut c_void
-}
-
-type OfxPluginEntryPoint = unsafe extern "C" fn(
-    *const c_char,
-    *const c_void,
-    OfxPropertySetHandle,
-    OfxPropertySetHandle,
-) -> OfxStatus;
-
-/// Runs one interact action.
+/// The overlay interact's main entry point of node type `E`.
 ///
 /// # Safety
 /// `action` null or NUL-terminated; `handle` null or the interact handle
 /// of the action; `in_args` null or the action's property set; all valid
 /// until this call returns, as OFX promises of every host. Interacts have
 /// no out-args.
-unsafe fn dispatch(
-    kind: NodeKind,
+pub(super) unsafe extern "C" fn main_entry<E: ImageEffect>(
     action: *const c_char,
     handle: *const c_void,
     in_args: OfxPropertySetHandle,
@@ -66,7 +47,7 @@ unsafe fn dispatch(
     let result = catch_unwind(AssertUnwindSafe(|| {
         let in_args = in_args.transpose()?;
         // SAFETY: `interact` is the action's interact handle.
-        unsafe { run(kind, action, interact, in_args) }
+        unsafe { run::<E>(action, interact, in_args) }
     }));
     match result {
         Ok(Ok(Reply::Done)) => kOfxStatOK,
@@ -85,10 +66,11 @@ unsafe fn dispatch(
     }
 }
 
+/// Reads one interact action's arguments and hands them to `E`'s overlay.
+///
 /// # Safety
 /// `interact` is the live interact handle of the action.
-unsafe fn run(
-    kind: NodeKind,
+unsafe fn run<E: ImageEffect>(
     action: &CStr,
     interact: OfxInteractHandle,
     in_args: Option<PropSet>,
@@ -102,8 +84,8 @@ unsafe fn run(
     // SAFETY: the caller's interact handle.
     let props = unsafe { props_of(suite, interact)? };
     if action == kOfxActionCreateInstance {
-        // Redraw when any line param changes.
-        let ids = overlay::slave_params();
+        // Redraw when any param the overlay shows changes.
+        let ids = E::Overlay::slave_params();
         let _ = props.set_strings(
             kOfxInteractPropSlaveToParam,
             &ids.iter().map(String::as_str).collect::<Vec<_>>(),
@@ -117,20 +99,22 @@ unsafe fn run(
         )
     })?;
     let effect = effect_of(&args, &props)?;
+    let attached = attachment(&effect)?;
+    let node = attached.node::<E>()?;
     let time = args.get_double(kOfxPropTime, 0)?;
     if action == kOfxInteractActionDraw {
         // SAFETY: `args` are the draw action's, read during it.
-        return unsafe { draw(kind, &effect, &args, time) };
+        return unsafe { draw::<E>(node, &effect, &args, time) };
     }
     if action == kOfxInteractActionKeyDown || action == kOfxInteractActionKeyRepeat {
         let sym = args.get_int(kOfxPropKeySym, 0)?;
-        return overlay::key_down(kind, &effect, sym, time);
+        return E::Overlay::key_down(node, &effect, sym, time);
     }
     if action == kOfxInteractActionKeyUp {
-        return overlay::key_up(&effect, args.get_int(kOfxPropKeySym, 0)?);
+        return E::Overlay::key_up(node, &effect, args.get_int(kOfxPropKeySym, 0)?);
     }
     if action == kOfxInteractActionLoseFocus {
-        return overlay::lose_focus(&effect);
+        return E::Overlay::lose_focus(node, &effect);
     }
     let pen = || -> Outcome<Pen> {
         let [x, y] = args.get_doubles::<2>(kOfxInteractPropPenPosition)?;
@@ -141,7 +125,7 @@ unsafe fn run(
         })
     };
     if action == kOfxInteractActionPenDown {
-        overlay::pen_down(kind, &effect, pen()?)
+        E::Overlay::pen_down(node, &effect, pen()?)
     } else if action == kOfxInteractActionPenMotion {
         let mut redraw = || {
             if let Some(f) = suite.interactRedraw {
@@ -149,9 +133,9 @@ unsafe fn run(
                 unsafe { f(interact) };
             }
         };
-        overlay::pen_motion(kind, &effect, pen()?, &mut redraw)
+        E::Overlay::pen_motion(node, &effect, pen()?, &mut redraw)
     } else if action == kOfxInteractActionPenUp {
-        overlay::pen_up(kind, &effect, pen()?)
+        E::Overlay::pen_up(node, &effect, pen()?)
     } else {
         Ok(Reply::Default)
     }
@@ -173,7 +157,7 @@ unsafe fn props_of(suite: &OfxInteractSuiteV1, interact: OfxInteractHandle) -> O
 
 /// The effect the interact belongs to: named in the action's arguments,
 /// or in the interact's own properties.
-fn effect_of(args: &PropSet, props: &PropSet) -> Outcome<Effect> {
+fn effect_of(args: &PropSet, props: &PropSet) -> Outcome<EffectHandle> {
     let handle = args
         .get_pointer(kOfxPropEffectInstance, 0)
         .ok()
@@ -185,7 +169,7 @@ fn effect_of(args: &PropSet, props: &PropSet) -> Outcome<Effect> {
         })?;
     // SAFETY: the host names the interact's effect instance, which
     // outlives its interacts (OFX: an interact is bound to one instance).
-    unsafe { Effect::from_raw(handle) }
+    unsafe { EffectHandle::from_raw(handle) }
 }
 
 /// Canonical units per screen pixel as the host says (1, 1 when it does not).
@@ -198,7 +182,12 @@ fn pixel_scale(args: &PropSet) -> (f64, f64) {
 
 /// # Safety
 /// `args` are the running draw action's arguments.
-unsafe fn draw(kind: NodeKind, effect: &Effect, args: &PropSet, time: f64) -> Outcome<Reply> {
+unsafe fn draw<E: ImageEffect>(
+    node: &E,
+    effect: &EffectHandle,
+    args: &PropSet,
+    time: f64,
+) -> Outcome<Reply> {
     let pixel = pixel_scale(args);
     let context = args
         .get_pointer(kOfxInteractPropDrawContext, 0)
@@ -207,13 +196,21 @@ unsafe fn draw(kind: NodeKind, effect: &Effect, args: &PropSet, time: f64) -> Ou
     if let (Some(context), Some(suite)) = (context, host::suites()?.draw) {
         // SAFETY: the draw action's own context, used only during it.
         let mut painter = unsafe { DrawSuitePainter::new(suite, context as OfxDrawContextHandle) };
-        return overlay::draw(kind, effect, time, pixel, &mut painter);
+        let args = DrawArgs {
+            time,
+            pixel,
+            measured: false,
+        };
+        return E::Overlay::draw(node, effect, &args, &mut painter);
     }
     match GlPainter::new(pixel) {
         Some(mut painter) => {
-            let measured = painter.pixel();
-            overlay::measured_pixel(effect, measured)?;
-            overlay::draw(kind, effect, time, measured, &mut painter)
+            let args = DrawArgs {
+                time,
+                pixel: painter.pixel(),
+                measured: true,
+            };
+            E::Overlay::draw(node, effect, &args, &mut painter)
         }
         // No Draw suite and no GL context: nothing to draw with.
         None => Ok(Reply::Done),

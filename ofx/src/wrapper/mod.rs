@@ -1,35 +1,30 @@
-//! All FFI of the plugin. Each `unsafe` block states why it is sound; every
-//! entry point goes through [`dispatch`], which null-checks, catches unwinds and
-//! maps errors to OFX statuses: no panic crosses the C ABI.
+//! The generic OpenFX layer: all FFI and all `unsafe` of the plugin, and it
+//! names no node. Nodes implement [`plugin::ImageEffect`] and its
+//! [`plugin::Overlay`]; [`exports::export!`] makes the bundle's entry points
+//! from a list of node types. Each `unsafe` block states why it is sound;
+//! every entry point null-checks, catches unwinds and maps errors to OFX
+//! statuses ([`dispatch`], [`interact`]): no panic crosses the C ABI.
 
-/// An OFX main entry point (`OfxPluginEntryPoint`) for a `$kind` node that
-/// hands the host's arguments to `$dispatch`, whose contract is the entry
-/// point's: the action's arguments as the host passed them.
-macro_rules! entry_point {
-    ($name:ident, $kind:expr, $dispatch:path) => {
-        unsafe extern "C" fn $name(
-            action: *const std::ffi::c_char,
-            handle: *const std::ffi::c_void,
-            in_args: openfx::sys::generic::core::OfxPropertySetHandle,
-            out_args: openfx::sys::generic::core::OfxPropertySetHandle,
-        ) -> openfx::sys::generic::core::OfxStatus {
-            // SAFETY: the host calls an entry point with an action's
-            // arguments, which is `$dispatch`'s contract.
-            unsafe { $dispatch($kind, action, handle, in_args, out_args) }
-        }
-    };
-}
-
+mod attach;
 pub mod clips;
-pub mod cpu;
-pub mod dispatch;
+mod context;
+mod cpu;
+mod describe;
+mod dispatch;
 mod draw;
-mod exports;
+pub mod exports;
 mod gl;
-pub mod host;
-pub mod interact;
+mod host;
+mod interact;
+pub mod keys;
+pub mod paint;
 pub mod params;
-pub mod props;
+pub mod plugin;
+mod props;
+pub mod spec;
+
+pub(crate) use exports::export;
+pub use host::verbose;
 
 use std::ffi::{CStr, CString};
 

@@ -7,8 +7,8 @@ use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::param::*;
 
 use super::props::PropSet;
+use super::spec::{Kind, ParamSpec, TextMode};
 use super::{check, host, Failure, Outcome};
-use crate::nodes::spec::{Kind, ParamSpec, TextMode};
 
 fn cstr(s: &str) -> CString {
     CString::new(s).unwrap_or_default()
@@ -343,6 +343,22 @@ unsafe impl Send for Params {}
 unsafe impl Sync for Params {}
 
 impl Params {
+    /// Params bound to no host (tests of what nodes compute without one):
+    /// every read and write fails as for a param the host never made.
+    #[cfg(test)]
+    pub fn unbound() -> Params {
+        // SAFETY: every field of the suite is an `Option` of a function
+        // pointer, for which all-zero bytes are `None`.
+        static NO_SUITE: OfxParameterSuiteV1 = unsafe { std::mem::zeroed() };
+        Params {
+            set: ParamSet {
+                set: std::ptr::null_mut(),
+                suite: &NO_SUITE,
+            },
+            handles: HashMap::new(),
+        }
+    }
+
     /// Whether the host made param `id` (a minimal host may not make every
     /// kind the plugin defines).
     pub fn has(&self, id: &str) -> bool {

@@ -12,30 +12,21 @@ use morphfx::features::{Feature, Side, Tween};
 use morphfx::geom::Vec2;
 use morphfx::warp::field::line_pairs_toward;
 
+use crate::wrapper::keys;
+use crate::wrapper::paint::Painter;
 pub use hit::{Handle, Part};
-use paint::{Frame, Painter};
+use paint::Frame;
 
 use super::lines::{self, end_id, slot_lines, SlotLine};
 use super::params::{
     slot_ids, EditSides, Reader, Settings, Show, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT, OVERLAY_SHOW,
 };
-use super::render::{context, warp_inputs};
-use super::{instance, NodeKind};
-use crate::wrapper::clips::Effect;
+use super::render::warp_inputs;
+use super::{Node, NodeKind, NodeState};
+use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::params::Params;
+use crate::wrapper::plugin::{DrawArgs, Overlay, Pen};
 use crate::wrapper::{Outcome, Reply};
-
-/// A pen event: when, where (canonical), and the view's canonical units
-/// per screen pixel.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pen {
-    /// The effect's time.
-    pub time: f64,
-    /// The pen's position, canonical.
-    pub at: Vec2,
-    /// Canonical units per screen pixel.
-    pub pixel: (f64, f64),
-}
 
 /// The overlay's state between actions, per effect instance.
 #[derive(Debug, Default)]
@@ -68,8 +59,48 @@ enum Drag {
 /// Shortest new line kept, in screen pixels: a click is not a line.
 const MIN_NEW_LINE_PX: f64 = 3.0;
 
+/// The overlay both nodes share: the line slots, drawn and edited.
+pub struct SlotOverlay;
+
+impl<N: Node> Overlay<N> for SlotOverlay {
+    fn slave_params() -> Vec<String> {
+        slave_params()
+    }
+    fn draw(
+        node: &N,
+        _: &EffectHandle,
+        args: &DrawArgs,
+        painter: &mut dyn Painter,
+    ) -> Outcome<Reply> {
+        draw(node.state(), args, painter)
+    }
+    fn pen_down(node: &N, _: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+        pen_down(node.state(), pen)
+    }
+    fn pen_motion(
+        node: &N,
+        _: &EffectHandle,
+        pen: Pen,
+        redraw: &mut dyn FnMut(),
+    ) -> Outcome<Reply> {
+        pen_motion(node.state(), pen, redraw)
+    }
+    fn pen_up(node: &N, _: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+        pen_up(node.state(), pen)
+    }
+    fn key_down(node: &N, _: &EffectHandle, key: i32, time: f64) -> Outcome<Reply> {
+        key_down(node.state(), key, time)
+    }
+    fn key_up(node: &N, _: &EffectHandle, key: i32) -> Outcome<Reply> {
+        key_up(node.state(), key)
+    }
+    fn lose_focus(node: &N, _: &EffectHandle) -> Outcome<Reply> {
+        lose_focus(node.state())
+    }
+}
+
 /// The params every overlay redraw depends on (the interact is slaved to them).
-pub fn slave_params() -> Vec<String> {
+fn slave_params() -> Vec<String> {
     let mut ids = vec![
         LINE_COUNT.to_owned(),
         OVERLAY_SHOW.to_owned(),
@@ -85,23 +116,15 @@ fn lock(state: &Mutex<State>) -> std::sync::MutexGuard<'_, State> {
     state.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Remembers the pixel scale an OpenGL draw derived from its projection,
-/// for the pen events that follow (they carry only the host's figure).
-pub fn measured_pixel(effect: &Effect, pixel: (f64, f64)) -> Outcome {
-    lock(&instance::get(effect)?.overlay).measured_pixel = Some(pixel);
-    Ok(())
-}
-
-/// Draws the overlay at `time` (returns at once when Show Lines is off).
-pub fn draw(
-    kind: NodeKind,
-    effect: &Effect,
-    time: f64,
-    pixel: (f64, f64),
-    painter: &mut dyn Painter,
-) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
-    let params = instance.params()?;
+/// Draws the overlay (returns at once when Show Lines is off). A pixel
+/// scale measured from the OpenGL projection is kept for the pen events
+/// that follow (they carry only the host's figure).
+fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Outcome<Reply> {
+    let (kind, time, pixel) = (instance.kind, args.time, args.pixel);
+    if args.measured {
+        lock(&instance.overlay).measured_pixel = Some(pixel);
+    }
+    let params = instance.params();
     let show: Show = Reader::new(params, kind, time).choice(OVERLAY_SHOW);
     if show == Show::Off {
         return Ok(Reply::Done);
@@ -109,7 +132,7 @@ pub fn draw(
     let settings = Settings::read(params, time, kind);
     let slots = slot_lines(&Reader::new(params, kind, time));
     // A scene that does not parse still leaves the slots to draw.
-    let (scene, t) = match warp_inputs(kind, &instance, &settings, time, &context(effect)) {
+    let (scene, t) = match warp_inputs(instance, &settings, time) {
         Ok(inputs) => {
             let n = inputs.features.len() - settings.lines.len();
             (inputs.features[..n].to_vec(), inputs.t)
@@ -180,9 +203,9 @@ fn pixel_of(state: &State, pen: &Pen) -> (f64, f64) {
 
 /// Pen down: grabs the handle under the pen, or starts a new line in the
 /// next free slot. One edit block (one undo step) until pen up.
-pub fn pen_down(kind: NodeKind, effect: &Effect, pen: Pen) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
-    let params = instance.params()?;
+fn pen_down(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
+    let kind = instance.kind;
+    let params = instance.params();
     let drag = {
         let state = lock(&instance.overlay);
         let (slots, sides) = reach(kind, params, &state, pen.time);
@@ -254,14 +277,9 @@ fn write_drag(params: &Params, drag: Drag, pen: Pen) -> Outcome {
 /// Pen motion: moves what is dragged; otherwise tracks the handle under the
 /// pen and asks for a redraw when it changes (and leaves the event to the
 /// host).
-pub fn pen_motion(
-    kind: NodeKind,
-    effect: &Effect,
-    pen: Pen,
-    redraw: &mut dyn FnMut(),
-) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
-    let params = instance.params()?;
+fn pen_motion(instance: &NodeState, pen: Pen, redraw: &mut dyn FnMut()) -> Outcome<Reply> {
+    let kind = instance.kind;
+    let params = instance.params();
     let mut state = lock(&instance.overlay);
     if let Some(drag) = state.drag {
         drop(state);
@@ -280,9 +298,9 @@ pub fn pen_motion(
 
 /// Pen up: the drag's last write, and its edit block closed. A click that
 /// drew no line takes its slot back.
-pub fn pen_up(kind: NodeKind, effect: &Effect, pen: Pen) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
-    let params = instance.params()?;
+fn pen_up(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
+    let kind = instance.kind;
+    let params = instance.params();
     let (drag, pixel) = {
         let mut state = lock(&instance.overlay);
         (state.drag.take(), pixel_of(&state, &pen))
@@ -313,22 +331,9 @@ fn screen_length(p: Vec2, q: Vec2, pixel: (f64, f64)) -> f64 {
     Vec2::new((q.x - p.x) / pixel.0, (q.y - p.y) / pixel.1).length()
 }
 
-/// Keys the overlay knows (OFX key symbols).
-mod keys {
-    use openfx::sys::image_effect_v1::key_syms::*;
-
-    /// Left and right Shift.
-    pub const SHIFT: [i32; 2] = [kOfxKey_Shift_L as i32, kOfxKey_Shift_R as i32];
-    /// Left and right Control.
-    pub const CONTROL: [i32; 2] = [kOfxKey_Control_L as i32, kOfxKey_Control_R as i32];
-    /// Delete and BackSpace.
-    pub const DELETE: [i32; 2] = [kOfxKey_Delete as i32, kOfxKey_BackSpace as i32];
-}
-
 /// Key down: modifiers narrow what the pen grabs (and stay the host's
 /// too); Delete or BackSpace clears the hovered line.
-pub fn key_down(kind: NodeKind, effect: &Effect, sym: i32, time: f64) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
+fn key_down(instance: &NodeState, sym: i32, time: f64) -> Outcome<Reply> {
     let hovered = {
         let mut state = lock(&instance.overlay);
         if keys::SHIFT.contains(&sym) {
@@ -345,13 +350,12 @@ pub fn key_down(kind: NodeKind, effect: &Effect, sym: i32, time: f64) -> Outcome
     let Some(handle) = hovered else {
         return Ok(Reply::Default);
     };
-    lines::clear(kind, instance.params()?, handle.slot, time)?;
+    lines::clear(instance.kind, instance.params(), handle.slot, time)?;
     Ok(Reply::Done)
 }
 
 /// Key up: releases a modifier.
-pub fn key_up(effect: &Effect, sym: i32) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
+fn key_up(instance: &NodeState, sym: i32) -> Outcome<Reply> {
     let mut state = lock(&instance.overlay);
     if keys::SHIFT.contains(&sym) {
         state.shift = false;
@@ -364,8 +368,7 @@ pub fn key_up(effect: &Effect, sym: i32) -> Outcome<Reply> {
 
 /// Focus lost: no key is held any more as far as we can know, and nothing
 /// is under the pen.
-pub fn lose_focus(effect: &Effect) -> Outcome<Reply> {
-    let instance = instance::get(effect)?;
+fn lose_focus(instance: &NodeState) -> Outcome<Reply> {
     let mut state = lock(&instance.overlay);
     state.shift = false;
     state.ctrl = false;

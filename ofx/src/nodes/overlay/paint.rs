@@ -7,31 +7,7 @@ use morphfx::geom::Vec2;
 use super::hit::{Handle, Part};
 use crate::nodes::lines::SlotLine;
 use crate::nodes::params::Show;
-
-/// Line patterns the overlay uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stipple {
-    /// Unbroken.
-    Solid,
-    /// Dashes: the in-between lines.
-    Dash,
-}
-
-/// Where the overlay's drawing goes. Points are canonical coordinates.
-pub trait Painter {
-    /// Colour (straight RGBA) of what follows.
-    fn colour(&mut self, rgba: [f32; 4]);
-    /// Line width in screen pixels of what follows.
-    fn width(&mut self, px: f32);
-    /// Line pattern of what follows.
-    fn stipple(&mut self, stipple: Stipple);
-    /// Separate segments: points in pairs.
-    fn lines(&mut self, points: &[Vec2]);
-    /// One connected polyline.
-    fn strip(&mut self, points: &[Vec2]);
-    /// A label whose baseline starts at `at`.
-    fn text(&mut self, at: Vec2, text: &str);
-}
+use crate::wrapper::paint::{Painter, Stipple, LABEL_PX};
 
 /// Everything one draw shows.
 pub struct Frame<'a> {
@@ -61,10 +37,6 @@ const SHADOW: [f32; 4] = [0.0, 0.0, 0.0, 0.8];
 const ARROW_PX: f64 = 10.0;
 const LABEL_GAP_PX: f64 = 6.0;
 const HANDLE_PX: f64 = 4.0;
-/// A label's cap height in screen pixels, for painters that draw text
-/// themselves (OpenGL has none).
-pub const LABEL_PX: f64 = 10.0;
-
 /// Draws `frame`: everything twice, a dark shadow one pixel down and right,
 /// then in colour, so it reads on any plate.
 pub fn paint(p: &mut dyn Painter, frame: &Frame<'_>) {

@@ -10,7 +10,7 @@ use morphfx::transition::{Rates, Weights};
 use morphfx::views::{self, View};
 use morphfx::warp::mesh::{self, MeshPair};
 
-use crate::nodes::instance::PLANES_KEPT;
+use crate::nodes::state::PLANES_KEPT;
 
 pub(super) struct Job<'a> {
     pub(super) view: View,

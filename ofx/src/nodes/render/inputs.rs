@@ -7,14 +7,14 @@ use morphfx::features::Feature;
 use morphfx::make_warp::WarpSettings;
 use morphfx::scene::Scene;
 
-use super::TRANSITION;
-use crate::nodes::instance::Instance;
 use crate::nodes::params::{Settings, TRANSITION_PARAM};
+use crate::nodes::state::NodeState;
 use crate::nodes::NodeKind;
+use crate::wrapper::plugin::Context;
 use crate::wrapper::{Failure, Outcome};
 
 /// The scene named by the params, parsed once per content.
-fn load_scene(instance: &Instance, settings: &Settings) -> Outcome<Option<Arc<Scene>>> {
+fn load_scene(instance: &NodeState, settings: &Settings) -> Outcome<Option<Arc<Scene>>> {
     let path = settings.scene_file.trim();
     let (key, source) = if !path.is_empty() {
         let meta = std::fs::metadata(path)
@@ -57,11 +57,9 @@ pub struct WarpInputs {
 }
 
 pub(in crate::nodes) fn warp_inputs(
-    kind: NodeKind,
-    instance: &Instance,
+    instance: &NodeState,
     settings: &Settings,
     time: f64,
-    context: &str,
 ) -> Outcome<WarpInputs> {
     let scene = load_scene(instance, settings)?;
     // The scene's features first, so transition curves attached by index
@@ -86,9 +84,9 @@ pub(in crate::nodes) fn warp_inputs(
         }
     }
     features.extend(settings.lines.iter().cloned());
-    if kind == NodeKind::Morph && context == TRANSITION {
+    if instance.kind == NodeKind::Morph && instance.context == Context::Transition {
         t = instance
-            .params()?
+            .params()
             .double(TRANSITION_PARAM, time)?
             .clamp(0.0, 1.0);
     }

@@ -20,16 +20,13 @@ use morphfx::views::View;
 use morphfx::warp::auto::WorkImage;
 use morphfx::warp::mesh::Pass;
 use morphfx::warp::Warp;
-use openfx::sys::generic::core::*;
-use openfx::sys::image_effect_v1::image_effect::*;
-use openfx::sys::image_effect_v1::message::*;
 
-use super::instance::{self, Instance};
 use super::params::Settings;
+use super::state::NodeState;
 use super::NodeKind;
 use crate::cache::Key;
-use crate::wrapper::clips::{Depth, Effect, HostImage, HostSample, ImageInfo};
-use crate::wrapper::props::PropSet;
+use crate::wrapper::clips::{Depth, EffectHandle, HostImage, HostSample, ImageInfo};
+use crate::wrapper::plugin::RenderArgs;
 use crate::wrapper::{Failure, Outcome};
 use draw::Job;
 pub(super) use inputs::warp_inputs;
@@ -58,24 +55,15 @@ macro_rules! with_depth {
     };
 }
 
-pub(super) const TRANSITION: &str = "OfxImageEffectContextTransition";
-
-pub(super) fn context(effect: &Effect) -> String {
-    effect
-        .props()
-        .and_then(|p| p.get_string(kOfxImageEffectPropContext, 0))
-        .unwrap_or_default()
-}
-
 /// The render action: gather, prepare, draw.
-pub fn render(kind: NodeKind, effect: &Effect, in_args: &PropSet) -> Outcome {
-    let instance = instance::get(effect)?;
-    let (mut request, mut lent) = gather(kind, effect, &instance, in_args)?;
+pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) -> Outcome {
+    let kind = instance.kind;
+    let (mut request, mut lent) = gather(instance, effect, args)?;
     if effect.aborted() {
         return Ok(());
     }
-    correspond(&instance, &mut request)?;
-    let job = prepare(kind, &instance, &request)?;
+    correspond(instance, &mut request)?;
+    let job = prepare(kind, instance, &request)?;
     if effect.aborted() {
         return Ok(());
     }
@@ -120,7 +108,7 @@ struct Lent {
 /// A source clip's image, or `None` where the host has none: an unconnected
 /// clip, or a fetch that failed, which the spec says to treat as transparent
 /// black and carry on.
-fn source(effect: &Effect, name: &str, time: f64) -> Outcome<Option<HostImage>> {
+fn source(effect: &EffectHandle, name: &str, time: f64) -> Outcome<Option<HostImage>> {
     let clip = effect.clip(name)?;
     if !clip.is_connected() {
         return Ok(None);
@@ -137,14 +125,11 @@ const MAX_RENDER_PIXELS: usize = 1 << 28;
 
 /// Everything one render reads from the host, and the images it holds.
 fn gather(
-    kind: NodeKind,
-    effect: &Effect,
-    instance: &Instance,
-    in_args: &PropSet,
+    instance: &NodeState,
+    effect: &EffectHandle,
+    args: &RenderArgs,
 ) -> Outcome<(Request, Lent)> {
-    let time = in_args.get_double(kOfxPropTime, 0)?;
-    let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
-    let window = RectI::new(x1, y1, x2, y2);
+    let (time, window, sequential) = (args.time, args.window, args.sequential);
     if window.area() > MAX_RENDER_PIXELS {
         // Maps and intermediate rows are sized by the window: refuse before
         // asking for memory no machine has (an allocation failure would
@@ -156,14 +141,10 @@ fn gather(
             window.height()
         )));
     }
-    let sequential = in_args
-        .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
-        .unwrap_or(0)
-        == 1;
-    let context = context(effect);
+    let kind = instance.kind;
     let settings = read_settings(kind, effect, instance, time)?;
-    let mut inputs = warp_inputs(kind, instance, &settings, time, &context)?;
-    let (a_name, b_name) = kind.source_clips(&context);
+    let mut inputs = warp_inputs(instance, &settings, time)?;
+    let (a_name, b_name) = kind.source_clips(instance.context);
     let a = source(effect, a_name, time + settings.offset_a as f64)?;
     let b = match b_name {
         Some(b) => source(effect, b, time + settings.offset_b as f64)?,
@@ -174,11 +155,8 @@ fn gather(
         .image(time)?
         .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
     // The spec: non-optional clips are always connected during a render.
-    let rod = regions::output_region(kind, effect, &context, time)?.ok_or_else(|| {
-        Failure::BadInput(format!(
-            "no source clip of {} is connected",
-            kind.info().label
-        ))
+    let rod = regions::output_region(instance, effect, time)?.ok_or_else(|| {
+        Failure::BadInput(format!("no source clip of {} is connected", kind.label()))
     })?;
     // Triangles pin the border of the frame, so the whole frame warps.
     inputs.warp.region = Some(regions::warp_region(effect, &rod));
@@ -220,11 +198,11 @@ fn gather(
 /// The params at `time`; params the host could not read are said once.
 fn read_settings(
     kind: NodeKind,
-    effect: &Effect,
-    instance: &Instance,
+    effect: &EffectHandle,
+    instance: &NodeState,
     time: f64,
 ) -> Outcome<Settings> {
-    let settings = Settings::read(instance.params()?, time, kind);
+    let settings = Settings::read(instance.params(), time, kind);
     if let Some(first) = settings.unreadable.first() {
         return Err(Failure::Failed(format!(
             "the host could not give {} of this node's params at frame {time}: {first}",
@@ -232,8 +210,7 @@ fn read_settings(
         )));
     }
     if !settings.missing.is_empty() && instance.first_time("missing params") {
-        effect.message(
-            kOfxMessageWarning,
+        effect.warning(
             c"net.morphfx.MissingParams",
             &format!(
                 "the host could not read these params; their defaults are used: {}",
@@ -289,7 +266,7 @@ fn canonical(bounds: RectI, scale: PixelScale) -> RectD {
 
 /// Method `auto`: the correspondence of the two work images, which the
 /// maps are then made from like any method's.
-fn correspond(instance: &Instance, request: &mut Request) -> Outcome {
+fn correspond(instance: &NodeState, request: &mut Request) -> Outcome {
     if let Some([a, b]) = &request.work {
         let covers = |k: usize| request.sources[k].map_or(RectD::default(), |s| s.covers);
         let c = warm::correspondence(
@@ -308,7 +285,7 @@ fn correspond(instance: &Instance, request: &mut Request) -> Outcome {
 /// what [`gather`] read: the maps for the render window, the dissolve
 /// weights, the transition rates. Pure given the instance's caches: no
 /// host call.
-fn prepare<'r>(kind: NodeKind, instance: &'r Instance, request: &'r Request) -> Outcome<Job<'r>> {
+fn prepare<'r>(kind: NodeKind, instance: &'r NodeState, request: &'r Request) -> Outcome<Job<'r>> {
     let inputs = &request.inputs;
     let view = request.settings.view;
     // The two-pass mesh warp makes pixels (per render window), not a map:
@@ -380,7 +357,7 @@ fn bad_input(e: morphfx::Error) -> Failure {
 /// The map of `side`'s warp over the render window, from the cache or made.
 /// Maps cover the render window, never more: a tile costs its own pixels,
 /// and an infinite region of definition costs nothing extra.
-fn map(instance: &Instance, request: &Request, side: Side) -> Outcome<Arc<WarpMap>> {
+fn map(instance: &NodeState, request: &Request, side: Side) -> Outcome<Arc<WarpMap>> {
     let (inputs, window, scale) = (&request.inputs, request.window, request.out_scale);
     let key = Key::of(&(inputs, side, window, scale));
     instance.warps.get_or_compute(key, || {
@@ -396,7 +373,7 @@ fn map(instance: &Instance, request: &Request, side: Side) -> Outcome<Arc<WarpMa
 
 /// The per-pixel dissolve weights of a non-uniform colour transition.
 fn weights(
-    instance: &Instance,
+    instance: &NodeState,
     request: &Request,
     ma: &WarpMap,
     mb: &WarpMap,
@@ -490,6 +467,8 @@ fn draw(kind: NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Ou
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::wrapper::params::Params;
+    use crate::wrapper::plugin::Context;
     use morphfx::features::Feature;
     use morphfx::make_warp::WarpSettings;
 
@@ -532,7 +511,7 @@ mod tests {
     /// them in the cache.
     #[test]
     fn prepare_makes_the_cores_maps_for_the_window_once() {
-        let instance = Instance::default();
+        let instance = NodeState::create(NodeKind::Morph, Context::General, Params::unbound());
         let r = request(0.25, View::Morph);
         let job = prepare(NodeKind::Morph, &instance, &r).expect("prepared");
         for (side, got) in [(Side::A, &job.map_a), (Side::B, &job.map_b)] {
@@ -555,7 +534,7 @@ mod tests {
     /// Views take only the maps they draw: the Warp node never makes B's.
     #[test]
     fn prepare_makes_only_the_maps_a_view_draws() {
-        let instance = Instance::default();
+        let instance = NodeState::create(NodeKind::Morph, Context::General, Params::unbound());
         let r = request(0.5, View::StmapB);
         let stmap_b = prepare(NodeKind::Morph, &instance, &r).unwrap();
         assert!(stmap_b.map_a.is_none() && stmap_b.map_b.is_some());

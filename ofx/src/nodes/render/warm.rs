@@ -12,14 +12,14 @@ use morphfx::warp::thin_plate::ThinPlateWarp;
 
 use super::inputs::WarpInputs;
 use crate::cache::Key;
-use crate::nodes::instance::{Instance, GRIDS_KEPT, PLATES_KEPT};
+use crate::nodes::state::{NodeState, GRIDS_KEPT, PLATES_KEPT};
 use crate::wrapper::{Failure, Outcome};
 
 /// The frame's `auto` correspondence: solved once per content of the two
 /// images and settings (tiles and repeated renders share it), warm-started
 /// from the previous frame's grid when this instance solved it.
 pub(super) fn correspondence(
-    instance: &Instance,
+    instance: &NodeState,
     inputs: &WarpInputs,
     (time, sequential): (f64, bool),
     (a, a_frame): (&WorkImage, RectD),
@@ -62,7 +62,7 @@ pub(super) fn correspondence(
             warm.as_ref(),
         )
         .map_err(|e| Failure::BadInput(e.to_string()))?;
-        if crate::wrapper::host::switches().verbose {
+        if crate::wrapper::verbose() {
             eprintln!(
                 "auto: frame {time}: {}x{} to {}x{}, {} start, {:.2} s\n{}",
                 a.width,
@@ -93,7 +93,7 @@ pub(super) fn correspondence(
 /// frame of the sequence) with the same settings: Lee et al.'s warm start,
 /// since features move little from frame to frame.
 pub(super) fn thin_plate(
-    instance: &Instance,
+    instance: &NodeState,
     inputs: &WarpInputs,
     side: Side,
     (time, sequential): (f64, bool),
@@ -118,7 +118,7 @@ pub(super) fn thin_plate(
         warm.as_deref(),
     )
     .map_err(|e| Failure::BadInput(e.to_string()))?;
-    if crate::wrapper::host::switches().verbose {
+    if crate::wrapper::verbose() {
         let cycles = |r: &Report| r.residuals.len() - 1;
         eprintln!(
             "thin-plate: frame {time} side {side:?}: {} start, {} + {} cycles",

@@ -1,7 +1,6 @@
 //! Per-instance state: the warp cache, the parsed scene, messages said once.
 
 use std::collections::HashSet;
-use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 use morphfx::image::Plane;
@@ -10,21 +9,17 @@ use morphfx::transition::Weights;
 use morphfx::warp::auto::{Correspondence, Grid};
 use morphfx::warp::thin_plate::ThinPlate;
 
-use super::params::table_in_context;
-use super::render::context;
 use super::NodeKind;
 use crate::cache::{Cache, Key, WarpCache};
-use crate::wrapper::clips::Effect;
 use crate::wrapper::params::Params;
-use crate::wrapper::{dispatch, Failure, Outcome};
+use crate::wrapper::plugin::Context;
 
-#[derive(Default)]
-pub struct Instance {
+pub struct NodeState {
+    pub kind: NodeKind,
+    /// The context the host made the instance in.
+    pub context: Context,
     /// The instance's params, their handles fetched once at creation.
-    params: Option<Params>,
-    /// A render failure's persistent message is on the node (cleared by the
-    /// next good render).
-    pub error_shown: AtomicBool,
+    params: Params,
     pub warps: WarpCache,
     /// The last scene parsed, keyed by where it came from (text, or path + mtime + size).
     pub scene: Mutex<Option<(String, Arc<Scene>)>>,
@@ -57,12 +52,30 @@ pub const PLATES_KEPT: usize = 4;
 /// A morph needs two planes.
 pub const PLANES_KEPT: usize = 2;
 
-impl Instance {
+impl NodeState {
+    /// A new instance's state over its params; the line slots past Line
+    /// Count hidden.
+    pub fn create(kind: NodeKind, context: Context, params: Params) -> NodeState {
+        super::lines::hide_unused(kind, &params, 0.0);
+        NodeState {
+            kind,
+            context,
+            params,
+            warps: Default::default(),
+            scene: Default::default(),
+            said: Default::default(),
+            planes: Default::default(),
+            correspondences: Default::default(),
+            grids: Default::default(),
+            plates: Default::default(),
+            weights: Default::default(),
+            overlay: Default::default(),
+        }
+    }
+
     /// The instance's params.
-    pub fn params(&self) -> Outcome<&Params> {
-        self.params
-            .as_ref()
-            .ok_or_else(|| Failure::Failed("instance created without its params".into()))
+    pub fn params(&self) -> &Params {
+        &self.params
     }
 
     /// Frees what the instance caches: warps, weights, correspondences,
@@ -89,24 +102,4 @@ impl Instance {
             .unwrap_or_else(|e| e.into_inner())
             .insert(what.to_owned())
     }
-}
-
-/// Makes the instance's state, with a handle for every param it defines.
-pub fn create(kind: NodeKind, effect: &Effect) -> Outcome {
-    let table = table_in_context(kind, &context(effect));
-    let params = effect.param_set()?.bind(&table);
-    super::lines::hide_unused(kind, &params, 0.0);
-    let instance = Instance {
-        params: Some(params),
-        ..Instance::default()
-    };
-    dispatch::attach_instance(effect, Arc::new(instance))
-}
-
-pub fn destroy(effect: &Effect) -> Outcome {
-    dispatch::detach_instance(effect)
-}
-
-pub fn get(effect: &Effect) -> Outcome<Arc<Instance>> {
-    dispatch::instance(effect)
 }

@@ -1,0 +1,134 @@
+//! The options of the nodes' choice params, in the order hosts save them.
+
+use morphfx::choice::Choice;
+use morphfx::make_warp::Method;
+use morphfx::transition::procedural::PatternKind;
+use morphfx::views::View;
+
+use crate::nodes::NodeKind;
+
+/// What the viewer overlay shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Show {
+    /// A's and B's lines, their connectors and the in-between lines.
+    Both,
+    /// A's lines only.
+    A,
+    /// B's lines only.
+    B,
+    /// The in-between lines at the current progress only.
+    Between,
+    /// Nothing.
+    Off,
+}
+
+impl Choice for Show {
+    const ALL: &'static [Self] = &[Show::Both, Show::A, Show::B, Show::Between, Show::Off];
+    fn name(self) -> &'static str {
+        match self {
+            Show::Both => "A and B",
+            Show::A => "A only",
+            Show::B => "B only",
+            Show::Between => "in-between",
+            Show::Off => "off",
+        }
+    }
+}
+
+/// Which lines the overlay lets the pen move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EditSides {
+    /// A's and B's.
+    Both,
+    /// A's only (B's are drawn, locked).
+    A,
+    /// B's only.
+    B,
+}
+
+impl Choice for EditSides {
+    const ALL: &'static [Self] = &[EditSides::Both, EditSides::A, EditSides::B];
+    fn name(self) -> &'static str {
+        match self {
+            EditSides::Both => "A and B",
+            EditSides::A => "A only",
+            EditSides::B => "B only",
+        }
+    }
+}
+
+/// The methods a node offers, in choice order (hosts save the index: only
+/// ever append). Auto finds its warp from both pictures, so the Warp node,
+/// which has one, stops before it; auto is last, so no index moves.
+pub(super) fn methods(kind: NodeKind) -> &'static [Method] {
+    match kind {
+        NodeKind::Morph => Method::ALL,
+        NodeKind::Warp => &Method::ALL[..Method::ALL.len() - 1],
+    }
+}
+
+/// The views a node offers, in the order of its View choice.
+pub fn views(kind: NodeKind) -> &'static [View] {
+    match kind {
+        NodeKind::Morph => View::ALL,
+        NodeKind::Warp => &[View::WarpedA, View::StmapA, View::Grid],
+    }
+}
+
+pub(super) fn view_label(kind: NodeKind, v: View) -> &'static str {
+    match (kind, v) {
+        (NodeKind::Warp, View::WarpedA) => "warped",
+        (NodeKind::Warp, View::StmapA) => "stmap",
+        _ => v.name(),
+    }
+}
+
+/// The Transition param's options: uniform, then each procedural pattern
+/// (curves come from the scene).
+pub(super) const PATTERNS: [Option<PatternKind>; 5] = [
+    None,
+    Some(PatternKind::Ramp),
+    Some(PatternKind::SineRows),
+    Some(PatternKind::SineColumns),
+    Some(PatternKind::Radial),
+];
+
+pub(super) fn pattern_label(p: Option<PatternKind>) -> &'static str {
+    p.map_or("uniform", PatternKind::name)
+}
+
+/// How the field is evaluated (the tolerance is its own param).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum EvaluationMode {
+    Adaptive,
+    Exact,
+}
+
+impl Choice for EvaluationMode {
+    const ALL: &'static [Self] = &[EvaluationMode::Adaptive, EvaluationMode::Exact];
+    fn name(self) -> &'static str {
+        match self {
+            EvaluationMode::Adaptive => "adaptive",
+            EvaluationMode::Exact => "exact",
+        }
+    }
+}
+
+/// What a procedural transition paces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Affects {
+    Both,
+    Geometry,
+    Colour,
+}
+
+impl Choice for Affects {
+    const ALL: &'static [Self] = &[Affects::Both, Affects::Geometry, Affects::Colour];
+    fn name(self) -> &'static str {
+        match self {
+            Affects::Both => "geometry and colour",
+            Affects::Geometry => "geometry",
+            Affects::Colour => "colour",
+        }
+    }
+}

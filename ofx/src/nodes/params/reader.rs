@@ -1,0 +1,122 @@
+//! Param values read at a time, each by the table entry that defines it.
+
+use std::cell::RefCell;
+
+use morphfx::choice::Choice;
+use morphfx::geom::Vec2;
+
+use crate::nodes::NodeKind;
+use crate::wrapper::params::Params;
+use crate::wrapper::spec::{Kind, ParamSpec};
+use crate::wrapper::Outcome;
+
+use super::table::spec;
+
+/// Reads params at one time, each by the table entry that defines it: the
+/// default it declares stands in for a value the host cannot give, and its
+/// range bounds the value.
+pub struct Reader<'a> {
+    /// `None`: every param at its default.
+    pub(super) params: Option<&'a Params>,
+    pub(super) kind: NodeKind,
+    pub(super) time: f64,
+    pub(super) missing: RefCell<Vec<String>>,
+    pub(super) unreadable: RefCell<Vec<String>>,
+}
+
+impl<'a> Reader<'a> {
+    pub fn new(params: &'a Params, kind: NodeKind, time: f64) -> Self {
+        Reader {
+            params: Some(params),
+            kind,
+            time,
+            missing: RefCell::new(Vec::new()),
+            unreadable: RefCell::new(Vec::new()),
+        }
+    }
+
+    pub(super) fn spec(&self, id: &str) -> &'static ParamSpec {
+        spec(self.kind, id)
+            .unwrap_or_else(|| panic!("param {id} is read but not in the node's table"))
+    }
+
+    /// The host's value, or `None` (and `id` noted missing or unreadable).
+    pub(super) fn host<T>(&self, id: &str, read: impl FnOnce(&Params) -> Outcome<T>) -> Option<T> {
+        let params = self.params?;
+        match read(params) {
+            Ok(v) => Some(v),
+            Err(why) if params.has(id) => {
+                self.unreadable.borrow_mut().push(why.message().to_owned());
+                None
+            }
+            Err(_) => {
+                self.missing.borrow_mut().push(id.to_owned());
+                None
+            }
+        }
+    }
+
+    pub fn double(&self, id: &str) -> f64 {
+        let Kind::Double {
+            default, min, max, ..
+        } = self.spec(id).kind
+        else {
+            panic!("param {id} is not a double");
+        };
+        match self.host(id, |p| p.double(id, self.time)) {
+            Some(v) if v.is_finite() => v.clamp(min, max),
+            _ => default,
+        }
+    }
+
+    pub fn int(&self, id: &str) -> i32 {
+        let Kind::Int { default, min, max } = self.spec(id).kind else {
+            panic!("param {id} is not an integer");
+        };
+        self.host(id, |p| p.int(id, self.time))
+            .map_or(default, |v| v.clamp(min, max))
+    }
+
+    pub fn bool(&self, id: &str) -> bool {
+        let Kind::Bool { default } = self.spec(id).kind else {
+            panic!("param {id} is not a boolean");
+        };
+        self.host(id, |p| p.int(id, self.time))
+            .map_or(default, |v| v != 0)
+    }
+
+    /// The option of `options` the host's index picks (the list the table
+    /// defined the param with), else the declared default.
+    pub(super) fn pick<C: Copy>(&self, id: &str, options: &[C]) -> C {
+        let Kind::Choice { default, .. } = &self.spec(id).kind else {
+            panic!("param {id} is not a choice");
+        };
+        self.host(id, |p| p.int(id, self.time))
+            .and_then(|i| usize::try_from(i).ok())
+            .and_then(|i| options.get(i))
+            .copied()
+            .unwrap_or(options[*default])
+    }
+
+    /// A [`Choice`] param, defined with its options in [`Choice::ALL`] order.
+    pub fn choice<C: Choice>(&self, id: &str) -> C {
+        self.pick(id, C::ALL)
+    }
+
+    pub fn text(&self, id: &str) -> String {
+        let Kind::Text { default, .. } = self.spec(id).kind else {
+            panic!("param {id} is not text");
+        };
+        self.host(id, |p| p.string(id, self.time))
+            .unwrap_or_else(|| default.to_owned())
+    }
+
+    /// A position param, `None` when the host cannot give it.
+    pub fn point(&self, id: &str) -> Option<Vec2> {
+        let Kind::Point { .. } = self.spec(id).kind else {
+            panic!("param {id} is not a position");
+        };
+        self.host(id, |p| p.point(id, self.time))
+            .map(|(x, y)| Vec2::new(x, y))
+    }
+}

@@ -1,0 +1,266 @@
+//! The params both nodes define, as one table per node: each param's
+//! id, label, hint, default and range stated once.
+
+use std::collections::HashMap;
+use std::sync::OnceLock;
+
+use morphfx::choice::Choice;
+use morphfx::image::{EdgeMode, Filter};
+use morphfx::make_warp::Method;
+use morphfx::warp::auto::grid::MAX_LEVEL;
+use morphfx::warp::auto::Coefficients;
+use morphfx::warp::field::{Evaluation, FieldSettings, LineInterpolation};
+use morphfx::warp::mesh::Pass;
+use morphfx::warp::mffd::MffdSettings;
+use morphfx::warp::thin_plate::ThinPlateSettings;
+
+use crate::nodes::NodeKind;
+use crate::wrapper::plugin::Context;
+use crate::wrapper::spec::{Kind, ParamSpec, TextMode};
+
+use super::choices::{
+    methods, pattern_label, view_label, views, Affects, EditSides, EvaluationMode, Show, PATTERNS,
+};
+use super::ids::*;
+
+/// A choice param's kind: `options` labelled by `label`, `default` first
+/// unless said otherwise.
+pub(super) fn choice_of<C: Copy + PartialEq>(
+    options: &[C],
+    label: impl Fn(C) -> &'static str,
+    default: C,
+) -> Kind {
+    Kind::Choice {
+        options: options.iter().map(|o| label(*o)).collect(),
+        default: options.iter().position(|o| *o == default).unwrap_or(0),
+    }
+}
+
+/// A [`Choice`] param's kind, options in [`Choice::ALL`] order.
+pub(super) fn choice<C: Choice>(default: C) -> Kind {
+    choice_of(C::ALL, C::name, default)
+}
+
+/// The node's params, built once per kind.
+pub fn table(kind: NodeKind) -> &'static [ParamSpec] {
+    static MORPH: OnceLock<Vec<ParamSpec>> = OnceLock::new();
+    static WARP: OnceLock<Vec<ParamSpec>> = OnceLock::new();
+    match kind {
+        NodeKind::Morph => MORPH.get_or_init(|| build_table(kind)),
+        NodeKind::Warp => WARP.get_or_init(|| build_table(kind)),
+    }
+}
+
+pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
+    let d = FieldSettings::default();
+    let c = Coefficients::default();
+    let tp = ThinPlateSettings::default();
+    let mut t = vec![
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", choice_of(methods(kind), Method::name, Method::Field)),
+        ParamSpec::new(
+            PROGRESS,
+            "Progress",
+            "t in [0, 1]: 0 shows A unchanged, 1 shows B (Morph) or A warped fully onto B's features (Warp). Ignored in the transition context, where the host's Transition param drives it.",
+            Kind::Double { default: 0.5, min: 0.0, max: 1.0, display: (0.0, 1.0) },
+        ),
+        ParamSpec::new(USE_SCENE_PROGRESS, "Use Scene Progress", "When the scene keys progress, follow it instead of the Progress param.", Kind::Bool { default: true }),
+        ParamSpec::new(SETTINGS_FROM_SCENE, "Settings From Scene", "When a scene is loaded, its method and field settings win over this node's.", Kind::Bool { default: true }),
+        ParamSpec::new("field_group", "Field", "Beier-Neely field constants", Kind::Group { open: true }),
+        ParamSpec::new(FIELD_A, "a", "weight = (length^p / (a + dist))^b. Barely above 0 pins pixels on a line to it; larger is smoother.", Kind::Double { default: d.a, min: 1e-6, max: 1000.0, display: (0.0001, 10.0) }).in_group("field_group"),
+        ParamSpec::new(FIELD_B, "b", "How fast a line's influence falls off with distance (0.5 to 2 is most useful).", Kind::Double { default: d.b, min: 0.0, max: 10.0, display: (0.0, 4.0) }).in_group("field_group"),
+        ParamSpec::new(FIELD_P, "p", "How much longer lines outweigh shorter ones (0: all equal, 1: by length).", Kind::Double { default: d.p, min: 0.0, max: 4.0, display: (0.0, 1.0) }).in_group("field_group"),
+        ParamSpec::new(INTERPOLATION, "Line Interpolation", "endpoints: endpoints move straight; center-angle: centre, angle and length interpolate (rotating lines keep their length).", choice(LineInterpolation::Endpoints)).in_group("field_group"),
+        ParamSpec::new(EVALUATION, "Evaluation", "adaptive: coarse grid refined where needed, within Tolerance of exact; exact: every pixel.", choice(EvaluationMode::Adaptive)).in_group("field_group"),
+        ParamSpec::new(TOLERANCE, "Tolerance", "Largest error of the adaptive evaluation, in pixels.", Kind::Double { default: Evaluation::DEFAULT_TOLERANCE, min: 0.001, max: 5.0, display: (0.01, 1.0) }).in_group("field_group").animated(false),
+        ParamSpec::new("mesh_group", "Mesh", "Mesh warp (the mesh comes from the scene's \"mesh\" key)", Kind::Group { open: false }),
+        ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", choice(Pass::TwoPass)).in_group("mesh_group").animated(false),
+        ParamSpec::new("auto_group", "Auto", "Automatic correspondence by work minimisation (method auto)", Kind::Group { open: false }),
+        ParamSpec::new(AUTO_LEVELS, "Levels", "Depth of the search: 2^levels quads per side. 0: quads of about 4 pixels (6 at 256, 8 at HD). Fewer levels are faster and coarser.", Kind::Int { default: 0, min: 0, max: MAX_LEVEL as i32 }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_COLOUR, "Colour Work", "How hard the warp tries to match B's colours (the weight of re-colouring work).", Kind::Double { default: c.colour, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_STRETCH, "Stretch Work", "How much the warp resists stretching. 0 with Angle Work 0 gives a more fluid warp.", Kind::Double { default: c.stretch, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_ANGLE, "Angle Work", "How much the warp resists changing angles (shearing).", Kind::Double { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_ANCHORS, "Anchor Weight", "How strongly features (line slots, scene features) hold as anchor points.", Kind::Double { default: c.anchor, min: 0.0, max: 1000.0, display: (0.0, 100.0) }).in_group("auto_group").animated(false),
+        ParamSpec::new(AUTO_WARM_START, "Warm Start", "Start each frame from the previous frame's warp when this instance has it: faster, steadier over a sequence; off makes every frame independent of render order.", Kind::Bool { default: true }).in_group("auto_group").animated(false),
+        ParamSpec::new("scattered_group", "Thin Plate / MFFD", "Settings of the scattered-feature methods (thin-plate, mffd, hybrid)", Kind::Group { open: false }),
+        ParamSpec::new(PLATE_ALPHA, "Spring α", "How tightly the thin plate meets the feature points (px⁻²). Larger is tighter and slower to solve.", Kind::Double { default: tp.alpha, min: 0.01, max: 1e6, display: (1.0, 1000.0) }).in_group("scattered_group").animated(false),
+        ParamSpec::new(PLATE_BETA, "Glue β", "How soon a feature's pull dies away in the thin plate (px⁻⁴): it reaches about β^(-1/4) px. 0: no glue, the pull spreads over the frame.", Kind::Double { default: tp.beta, min: 0.0, max: 1.0, display: (0.0, 1e-4) }).in_group("scattered_group").animated(false),
+        ParamSpec::new(MFFD_ALPHA, "Refine α", "MFFD moves to a finer lattice when a step gains less than α (0.48 h)²: small values keep the deformation coarse and smooth.", Kind::Double { default: MffdSettings::default().alpha, min: 0.0, max: 1.0, display: (0.0, 1.0) }).in_group("scattered_group").animated(false),
+        ParamSpec::new("transition_group", "Transition", "How fast each part changes (transition curves come from the scene's \"transition\" key)", Kind::Group { open: false }),
+        ParamSpec::new(TRANSITION, "Transition", "uniform: every pixel at Progress; ramp, sine-rows, sine-columns, radial: each pixel's turn comes from where it is on A, every pixel still exactly A at 0 and B at 1.", choice_of(&PATTERNS, pattern_label, None)).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_AFFECTS, "Affects", "What the transition paces: the geometry (where features are) and the colour (the dissolve), or one of them (the other stays uniform).", choice(Affects::Both)).in_group("transition_group").animated(false),
+        ParamSpec::new(TRANSITION_SPREAD, "Spread", "Share of the progress over which the pattern sweeps: 0 is uniform; near 1 each pixel changes almost at once, at its turn.", Kind::Double { default: 0.5, min: 0.0, max: 0.99, display: (0.0, 0.99) }).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_ANGLE, "Angle", "Direction of the ramp in degrees: 0 left to right, 90 bottom to top.", Kind::Double { default: 0.0, min: -360.0, max: 360.0, display: (-180.0, 180.0) }).in_group("transition_group"),
+        ParamSpec::new(TRANSITION_CYCLES, "Cycles", "Sinusoid periods across the frame (sine patterns), or rings (radial; 0: the centre first, then outward).", Kind::Double { default: 2.0, min: 0.0, max: 100.0, display: (0.0, 8.0) }).in_group("transition_group"),
+        ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
+        ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
+        ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(SNAP_SIGMA, "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Kind::Double { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group("lines_group").animated(false),
+        ParamSpec::new(TRACK_FORWARD, "Track Forward", "Follows every enabled line through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(TRACK_BACKWARD, "Track Backward", "As Track Forward, towards the start: to the previous key, or the first frame of the clip.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(OVERLAY_SHOW, "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", choice(Show::Both)).in_group("lines_group").animated(false),
+        ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which lines the pen moves in the viewer. Drag an end, or a line by its middle; drag in empty space to draw a new line. Hold Shift to grab only A's lines, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
+    ];
+    for k in 1..=LINE_SLOTS {
+        t.extend(slot_specs(k));
+    }
+    t.extend([
+        ParamSpec::new(
+            "scene_group",
+            "Scene",
+            "A MorphFX scene (.morph.json) with keyframed features, mesh and settings",
+            Kind::Group { open: false },
+        ),
+        ParamSpec::new(
+            SCENE_FILE,
+            "Scene File",
+            "Path of a .morph.json scene; its features add to the line slots.",
+            Kind::Text {
+                default: "",
+                mode: TextMode::FilePath,
+            },
+        )
+        .in_group("scene_group"),
+        ParamSpec::new(
+            SCENE_TEXT,
+            "Scene Text",
+            "A scene as JSON text (used when Scene File is empty).",
+            Kind::Text {
+                default: "",
+                mode: TextMode::MultiLine,
+            },
+        )
+        .in_group("scene_group"),
+        ParamSpec::new(
+            OFFSET_A,
+            if kind == NodeKind::Morph {
+                "Frame Offset A"
+            } else {
+                "Frame Offset"
+            },
+            "Frames added to the time at which the source is read (sequence morphs).",
+            Kind::Int {
+                default: 0,
+                min: -100000,
+                max: 100000,
+            },
+        )
+        .animated(false),
+    ]);
+    if kind == NodeKind::Morph {
+        t.push(
+            ParamSpec::new(
+                OFFSET_B,
+                "Frame Offset B",
+                "Frames added to the time at which Source B is read.",
+                Kind::Int {
+                    default: 0,
+                    min: -100000,
+                    max: 100000,
+                },
+            )
+            .animated(false),
+        );
+    }
+    t.extend([
+        ParamSpec::new(
+            FILTER,
+            "Filter",
+            "bilinear, or bicubic (Catmull-Rom: sharper, may overshoot).",
+            choice(Filter::Bilinear),
+        ),
+        ParamSpec::new(
+            EDGE,
+            "Edge",
+            "Outside the source: clamp to the edge pixels, black (transparent), or mirror.",
+            choice(EdgeMode::Clamp),
+        ),
+        ParamSpec::new(
+            VIEW,
+            "View",
+            "What the node outputs.",
+            choice_of(views(kind), |v| view_label(kind, v), views(kind)[0]),
+        ),
+    ]);
+    t
+}
+
+/// Line slot `k`'s params, in their own group: enable, the four ends, Clear.
+pub(super) fn slot_specs(k: usize) -> Vec<ParamSpec> {
+    let [enable, a0, a1, b0, b1] = slot_ids(k);
+    let group = slot_group(k);
+    // Default lines stacked down the frame, so slots added one by one in a
+    // host without the overlay do not all start on top of each other.
+    let y = 100.0 + 40.0 * ((k - 1) % 16) as f64;
+    let mut specs = vec![
+        ParamSpec::new(
+            group.clone(),
+            format!("Line {k}"),
+            format!("Line pair {k}"),
+            Kind::Group { open: false },
+        )
+        .in_group("lines_group"),
+        ParamSpec::new(
+            enable,
+            "Enabled",
+            format!("Use line pair {k}."),
+            Kind::Bool { default: true },
+        )
+        .in_group(group.clone()),
+    ];
+    for (id, label, x) in [
+        (a0, "A Start", 100.0),
+        (a1, "A End", 300.0),
+        (b0, "B Start", 100.0),
+        (b1, "B End", 300.0),
+    ] {
+        specs.push(
+            ParamSpec::new(
+                id,
+                format!("Line {k} {label}"),
+                format!("Line {k}: {label} (canonical pixels, y up)."),
+                Kind::Point { default: (x, y) },
+            )
+            .in_group(group.clone()),
+        );
+    }
+    specs.push(
+        ParamSpec::new(
+            slot_clear(k),
+            "Clear Line",
+            format!("Removes line {k}'s keys, puts it back where it started and turns it off."),
+            Kind::Button,
+        )
+        .in_group(group),
+    );
+    specs
+}
+
+/// The table entry of param `id`, through an index built once per node: a
+/// render reads a few hundred params from a table of several hundred.
+pub fn spec(kind: NodeKind, id: &str) -> Option<&'static ParamSpec> {
+    type Index = HashMap<&'static str, &'static ParamSpec>;
+    static MORPH: OnceLock<Index> = OnceLock::new();
+    static WARP: OnceLock<Index> = OnceLock::new();
+    let build = || table(kind).iter().map(|p| (p.id.as_str(), p)).collect();
+    let index = match kind {
+        NodeKind::Morph => MORPH.get_or_init(build),
+        NodeKind::Warp => WARP.get_or_init(build),
+    };
+    index.get(id).copied()
+}
+
+/// The params a node defines in `context`: its table, and in the
+/// transition context the mandated `Transition` param (Parameters Mandated
+/// In A Context: the plugin defines it, the host drives it).
+pub fn table_in_context(kind: NodeKind, context: Context) -> Vec<ParamSpec> {
+    let mut table = table(kind).to_vec();
+    if context == Context::Transition {
+        table.push(ParamSpec::new(
+            TRANSITION_PARAM,
+            "",
+            "",
+            Kind::HostDriven { default: 0.0 },
+        ));
+    }
+    table
+}

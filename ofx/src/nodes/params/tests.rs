@@ -1,0 +1,170 @@
+use morphfx::choice::Choice;
+use morphfx::image::EdgeMode;
+use morphfx::make_warp::Method;
+use morphfx::views::View;
+use morphfx::warp::field::FieldSettings;
+
+use crate::wrapper::spec::Kind;
+
+use super::choices::*;
+use super::ids::*;
+use super::settings::*;
+use super::table::*;
+use crate::nodes::NodeKind;
+
+/// Every choice param's options as MorphFX 1.0 shipped them. Hosts save
+/// a choice by its index, so a saved project reads these back by
+/// position: they may be followed by new options, never reordered,
+/// renamed or removed.
+const RELEASED: &[(NodeKind, &str, &[&str])] = &[
+    (
+        NodeKind::Morph,
+        METHOD,
+        &[
+            "field",
+            "mesh",
+            "triangles",
+            "thin-plate",
+            "mffd",
+            "hybrid",
+            "auto",
+        ],
+    ),
+    (
+        NodeKind::Warp,
+        METHOD,
+        &["field", "mesh", "triangles", "thin-plate", "mffd", "hybrid"],
+    ),
+    (
+        NodeKind::Morph,
+        VIEW,
+        &[
+            "morph",
+            "warped-a",
+            "warped-b",
+            "stmap-a",
+            "stmap-b",
+            "transition",
+            "grid",
+        ],
+    ),
+    (NodeKind::Warp, VIEW, &["warped", "stmap", "grid"]),
+];
+
+/// Choice params both nodes share, with their released options.
+const RELEASED_BOTH: &[(&str, &[&str])] = &[
+    (INTERPOLATION, &["endpoints", "center-angle"]),
+    (EVALUATION, &["adaptive", "exact"]),
+    (MESH_PASS, &["two-pass", "one-pass"]),
+    (
+        TRANSITION,
+        &["uniform", "ramp", "sine-rows", "sine-columns", "radial"],
+    ),
+    (
+        TRANSITION_AFFECTS,
+        &["geometry and colour", "geometry", "colour"],
+    ),
+    (FILTER, &["bilinear", "bicubic"]),
+    (EDGE, &["clamp", "black", "mirror"]),
+    (
+        OVERLAY_SHOW,
+        &["A and B", "A only", "B only", "in-between", "off"],
+    ),
+    (OVERLAY_EDIT, &["A and B", "A only", "B only"]),
+];
+
+fn released() -> Vec<(NodeKind, &'static str, &'static [&'static str])> {
+    let mut all = RELEASED.to_vec();
+    for kind in [NodeKind::Morph, NodeKind::Warp] {
+        all.extend(RELEASED_BOTH.iter().map(|(id, o)| (kind, *id, *o)));
+    }
+    all
+}
+
+fn options(kind: NodeKind, id: &str) -> Option<(Vec<&'static str>, usize)> {
+    table(kind)
+        .iter()
+        .find(|p| p.id == id)
+        .map(|p| match &p.kind {
+            Kind::Choice { options, default } => (options.clone(), *default),
+            other => panic!("{id} is not a choice: {other:?}"),
+        })
+}
+
+#[test]
+fn choice_options_only_ever_grow_at_the_end() {
+    for (kind, id, was) in released() {
+        let (now, _) = options(kind, id).unwrap_or_else(|| panic!("{kind:?} lost {id}"));
+        assert!(
+            now.starts_with(was),
+            "{kind:?} {id}: released {was:?}, now {now:?}"
+        );
+    }
+}
+
+#[test]
+fn every_choice_param_is_recorded_with_a_default_among_its_options() {
+    let recorded = released();
+    for kind in [NodeKind::Morph, NodeKind::Warp] {
+        for p in table(kind) {
+            if let Kind::Choice { options, default } = &p.kind {
+                assert!(
+                    recorded.iter().any(|(k, id, _)| *k == kind && *id == p.id),
+                    "{kind:?} {}: record its options in RELEASED",
+                    p.id
+                );
+                assert!(*default < options.len(), "{kind:?} {}", p.id);
+            }
+        }
+    }
+}
+
+/// The option lists the reader picks from are the ones the table
+/// defined, so index k reads back the option labelled k.
+#[test]
+fn choices_read_back_the_option_they_label() {
+    for kind in [NodeKind::Morph, NodeKind::Warp] {
+        let (labels, _) = options(kind, METHOD).expect("method");
+        let names: Vec<_> = methods(kind).iter().map(|m| m.name()).collect();
+        assert_eq!(labels, names);
+        let (labels, _) = options(kind, VIEW).expect("view");
+        let names: Vec<_> = views(kind).iter().map(|v| view_label(kind, *v)).collect();
+        assert_eq!(labels, names);
+    }
+    assert_eq!(
+        options(NodeKind::Morph, EDGE).expect("edge").0,
+        EdgeMode::names()
+    );
+}
+
+/// The defaults a fresh node renders with: what the table declares.
+#[test]
+fn defaults_are_the_tables() {
+    let s = Settings::defaults(NodeKind::Morph);
+    assert_eq!(s.warp.method, Method::Field);
+    assert_eq!(s.progress, 0.5);
+    assert_eq!(s.view, View::Morph);
+    assert_eq!(s.edge, EdgeMode::Clamp);
+    assert!(s.lines.is_empty() && s.missing.is_empty());
+    assert_eq!(s.warp.field, FieldSettings::default());
+    assert_eq!(Settings::defaults(NodeKind::Warp).view, View::WarpedA);
+}
+
+#[test]
+fn ids_are_unique_and_hints_speak_to_compositors() {
+    for kind in [NodeKind::Morph, NodeKind::Warp] {
+        let t = table(kind);
+        for (i, p) in t.iter().enumerate() {
+            assert!(t[i + 1..].iter().all(|q| q.id != p.id), "{} twice", p.id);
+            for stale in ["not yet", "seed", "CONTRACT", "§"] {
+                assert!(
+                    !p.label.contains(stale) && !p.hint.contains(stale),
+                    "{}: {stale:?} in {:?} / {:?}",
+                    p.id,
+                    p.label,
+                    p.hint
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,298 @@
+//! What a node is to this layer: the [`ImageEffect`] trait (what it
+//! declares as constants, what it does per action) and its [`Overlay`], with
+//! every action's arguments as typed values and its answers as setters, so a
+//! node never sees a property name or a status. Models: nih-plug's `Plugin`
+//! (a trait with associated constants, one entry per type) and the OpenFX
+//! Support library's `ImageEffect` (typed action arguments, host defaults).
+
+use std::ffi::CStr;
+
+use morphfx::geom::{RectD, RectI, Vec2};
+
+use super::clips::EffectHandle;
+pub use super::context::Context;
+use super::paint::Painter;
+use super::params::Params;
+use super::spec::ParamSpec;
+use super::{Outcome, Reply};
+
+/// The sample depths a node renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PixelDepth {
+    Byte,
+    Short,
+    Float,
+}
+
+/// The pixel layouts a clip takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Components {
+    Rgba,
+    Rgb,
+    Alpha,
+}
+
+/// How a node's renders may run side by side (`kOfxImageEffectPluginRenderThreadSafety`).
+#[allow(dead_code)] // the spec's three answers; a node picks one
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ThreadSafety {
+    /// Any number of renders at once, on any instances.
+    FullySafe,
+    /// One render at a time per instance.
+    InstanceSafe,
+    /// One render at a time in all.
+    Unsafe,
+}
+
+/// Whether frames must be rendered in order (`kOfxImageEffectInstancePropSequentialRender`).
+#[allow(dead_code)] // the spec's three answers; a node picks one
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sequential {
+    /// Any order.
+    No,
+    /// In order only.
+    Always,
+    /// Any order is correct; in order is cheaper.
+    Preferred,
+}
+
+/// What a node can do, as the host is told at describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Capabilities {
+    pub depths: &'static [PixelDepth],
+    pub thread_safety: ThreadSafety,
+    /// The host may split frames across threads (else the node does).
+    pub host_frame_threading: bool,
+    pub tiles: bool,
+    pub multi_resolution: bool,
+    pub temporal_access: bool,
+    pub multiple_clip_depths: bool,
+    pub multiple_clip_aspects: bool,
+    pub sequential: Sequential,
+}
+
+/// One clip a node defines in a context.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ClipSpec {
+    pub name: &'static str,
+    pub components: &'static [Components],
+    pub tiles: bool,
+    pub temporal_access: bool,
+    pub optional: bool,
+}
+
+/// What describe-in-context defines: the clips (`Output` among them) and the
+/// params.
+pub struct ContextSpec {
+    pub clips: Vec<ClipSpec>,
+    pub params: Vec<ParamSpec>,
+}
+
+/// The time and render scale of an action that asks about one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameArgs {
+    pub time: f64,
+    pub render_scale: (f64, f64),
+}
+
+/// The region-of-interest action: the output region about to be rendered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoiArgs {
+    pub time: f64,
+    pub render_scale: (f64, f64),
+    /// Canonical.
+    pub region: RectD,
+}
+
+/// Which field of interlaced footage a render makes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Field {
+    /// Progressive footage, or both fields at once.
+    Both,
+    Lower,
+    Upper,
+}
+
+/// A render or an identity question: one window of one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderArgs {
+    pub time: f64,
+    /// Pixels.
+    pub window: RectI,
+    pub render_scale: (f64, f64),
+    pub field: Field,
+    /// The host renders this instance's frames in order (warm starts allowed).
+    pub sequential: bool,
+}
+
+/// The clip (and its time) a node's output equals at some frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Identity {
+    pub clip: &'static str,
+    pub time: f64,
+}
+
+/// Why a param changed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ChangeReason {
+    /// The user edited it.
+    User,
+    /// The plugin set it.
+    Plugin,
+    /// Time moved, or anything else.
+    Other,
+}
+
+/// The instance-changed action for a param.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamChange {
+    pub name: String,
+    pub time: f64,
+    pub reason: ChangeReason,
+}
+
+/// A region of interest per input clip, set by the node.
+#[derive(Debug, Default)]
+pub struct Rois {
+    pub(super) set: Vec<(&'static str, RectD)>,
+}
+
+impl Rois {
+    pub fn set(&mut self, clip: &'static str, region: RectD) {
+        self.set.push((clip, region));
+    }
+}
+
+/// The frames each input clip is needed at, set by the node.
+#[derive(Debug, Default)]
+pub struct FramesNeeded {
+    pub(super) set: Vec<(&'static str, (f64, f64))>,
+}
+
+impl FramesNeeded {
+    pub fn set(&mut self, clip: &'static str, range: (f64, f64)) {
+        self.set.push((clip, range));
+    }
+}
+
+/// The clip preferences a node answers.
+#[derive(Debug, Default)]
+pub struct ClipPreferences {
+    pub(super) frame_varying: Option<bool>,
+    pub(super) premultiplied_output: Option<bool>,
+}
+
+impl ClipPreferences {
+    /// The output changes from frame to frame even when the inputs do not.
+    pub fn set_frame_varying(&mut self, varying: bool) {
+        self.frame_varying = Some(varying);
+    }
+    /// The output's colour is premultiplied by its alpha (else straight).
+    pub fn set_premultiplied_output(&mut self, premultiplied: bool) {
+        self.premultiplied_output = Some(premultiplied);
+    }
+}
+
+/// An OFX image effect. One type per plugin of the bundle; its instances
+/// are values of the type, made in `create` and dropped at destroy.
+pub trait ImageEffect: Sized + Send + Sync + 'static {
+    /// The plugin identifier, reverse-domain style.
+    const ID: &'static CStr;
+    /// (major, minor).
+    const VERSION: (u32, u32);
+    const LABEL: &'static str;
+    const DESCRIPTION: &'static str;
+    /// Where hosts list it.
+    const GROUPING: &'static str;
+    const CONTEXTS: &'static [Context];
+    const CAPABILITIES: Capabilities;
+    /// The viewer overlay.
+    type Overlay: Overlay<Self>;
+
+    /// The clips and params of a context.
+    fn describe_in_context(context: Context) -> ContextSpec;
+
+    /// An instance, its params bound to the host's.
+    fn create(effect: &EffectHandle, context: Context, params: Params) -> Outcome<Self>;
+
+    /// Frees what the instance caches.
+    fn purge(&self) {}
+
+    /// The output's region of definition; `None` leaves it to the host's default.
+    fn region_of_definition(
+        &self,
+        effect: &EffectHandle,
+        args: &FrameArgs,
+    ) -> Outcome<Option<RectD>>;
+
+    fn regions_of_interest(
+        &self,
+        effect: &EffectHandle,
+        args: &RoiArgs,
+        out: &mut Rois,
+    ) -> Outcome<Reply>;
+
+    fn frames_needed(
+        &self,
+        effect: &EffectHandle,
+        time: f64,
+        out: &mut FramesNeeded,
+    ) -> Outcome<Reply>;
+
+    fn clip_preferences(&self, effect: &EffectHandle, out: &mut ClipPreferences) -> Outcome<Reply>;
+
+    /// The source the output equals unchanged, if any.
+    fn is_identity(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome<Option<Identity>>;
+
+    fn render(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome;
+
+    fn param_changed(&self, effect: &EffectHandle, change: &ParamChange) -> Outcome;
+}
+
+/// A pen event: when, where (canonical), and the view's canonical units
+/// per screen pixel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pen {
+    /// The effect's time.
+    pub time: f64,
+    /// The pen's position, canonical.
+    pub at: Vec2,
+    /// Canonical units per screen pixel.
+    pub pixel: (f64, f64),
+}
+
+/// A draw action: when, and the view's canonical units per screen pixel,
+/// measured from the OpenGL projection where the host's own figure cannot
+/// be trusted (some hosts say (1, 1) at every zoom).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrawArgs {
+    pub time: f64,
+    pub pixel: (f64, f64),
+    /// `pixel` was measured from the projection, not told by the host.
+    pub measured: bool,
+}
+
+/// A node's viewer overlay: its actions on an instance of node `E`.
+pub trait Overlay<E>: 'static {
+    /// Params whose changes redraw the overlay.
+    fn slave_params() -> Vec<String>;
+    fn draw(
+        node: &E,
+        effect: &EffectHandle,
+        args: &DrawArgs,
+        painter: &mut dyn Painter,
+    ) -> Outcome<Reply>;
+    fn pen_down(node: &E, effect: &EffectHandle, pen: Pen) -> Outcome<Reply>;
+    /// `redraw` asks the host to draw the overlay again.
+    fn pen_motion(
+        node: &E,
+        effect: &EffectHandle,
+        pen: Pen,
+        redraw: &mut dyn FnMut(),
+    ) -> Outcome<Reply>;
+    fn pen_up(node: &E, effect: &EffectHandle, pen: Pen) -> Outcome<Reply>;
+    /// A key pressed (or repeating): its OFX key symbol (see `keys`).
+    fn key_down(node: &E, effect: &EffectHandle, key: i32, time: f64) -> Outcome<Reply>;
+    fn key_up(node: &E, effect: &EffectHandle, key: i32) -> Outcome<Reply>;
+    fn lose_focus(node: &E, effect: &EffectHandle) -> Outcome<Reply>;
+}
