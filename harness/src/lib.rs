@@ -1,6 +1,8 @@
 //! `morphfx`, the standalone harness: an OpenFX host for the MorphFX bundle
 //! (reached only through its C ABI), EXR/PNG/JPEG/TIFF frame IO, sequences.
 
+pub mod cli;
+pub mod commands;
 pub mod exr_zip;
 pub mod host;
 pub mod interrupt;

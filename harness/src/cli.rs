@@ -1,0 +1,192 @@
+//! The `morphfx` command line: its commands and their options (clap).
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+use morphfx::track::TrackSettings;
+
+use crate::io::{self};
+
+#[derive(Parser)]
+#[command(
+    name = "morphfx",
+    version,
+    about = "Render MorphFX morphs through the OpenFX plugin bundle"
+)]
+pub struct Cli {
+    /// The plugin bundle (MorphFX.ofx.bundle or its binary). Default: OFX_PLUGIN_PATH,
+    /// then the bundle built in this checkout, then /usr/OFX/Plugins.
+    #[arg(long, global = true)]
+    pub bundle: Option<PathBuf>,
+    /// Say more while rendering (method auto prints its work table per level).
+    #[arg(short, long, global = true)]
+    pub verbose: bool,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(clap::Args, Clone)]
+pub struct Common {
+    /// Scene file (*.morph.json).
+    #[arg(long, required_unless_present = "line")]
+    pub scene: Option<PathBuf>,
+    /// A line pair in the node's slot N, as a host would key it:
+    /// `N=ax0,ay0,ax1,ay1,bx0,by0,bx1,by1` (constant) or `N@FRAME=...` (a key
+    /// at FRAME; keys of one slot interpolate like a host's). Repeatable.
+    #[arg(long = "line", value_name = "SPEC")]
+    pub line: Vec<String>,
+    /// Progress t in [0, 1]; overrides the scene's progress keys.
+    #[arg(long)]
+    pub t: Option<f64>,
+    /// Frames to render, e.g. 1001-1048.
+    #[arg(long)]
+    pub frames: Option<String>,
+    /// Output file or #-padded sequence.
+    #[arg(short = 'o', long = "output")]
+    pub output: String,
+    /// Write half-float EXR (default: the precision of the first input).
+    #[arg(long, conflicts_with = "float")]
+    pub half: bool,
+    /// Write 32-bit float EXR (default: the precision of the first input).
+    #[arg(long)]
+    pub float: bool,
+    /// EXR compression: none, rle, zips, zip, piz, pxr24, b44, dwaa, dwab
+    /// (default: the first input's; zip for PNG, JPEG and TIFF inputs).
+    #[arg(long)]
+    pub compression: Option<String>,
+    /// Keep PNG, JPEG and TIFF code values as they are (default: decode
+    /// their sRGB to linear light on read, encode PNG output to sRGB).
+    #[arg(long)]
+    pub raw: bool,
+}
+
+impl Common {
+    pub fn colour(&self) -> io::Colour {
+        if self.raw {
+            io::Colour::Raw
+        } else {
+            io::Colour::Srgb
+        }
+    }
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render the in-between image(s) of A and B.
+    Morph {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long)]
+        a: String,
+        #[arg(long)]
+        b: String,
+        #[arg(long = "stmap-a")]
+        stmap_a: Option<String>,
+        #[arg(long = "stmap-b")]
+        stmap_b: Option<String>,
+        /// morph, warped-a, warped-b, stmap-a, stmap-b, transition, grid
+        #[arg(long, default_value = "morph")]
+        view: String,
+        /// general or transition
+        #[arg(long, default_value = "general")]
+        context: String,
+    },
+    /// Render A warped toward the features' positions at t.
+    Warp {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long)]
+        input: String,
+        #[arg(long)]
+        stmap: Option<String>,
+        /// warped, stmap, grid
+        #[arg(long, default_value = "warped")]
+        view: String,
+    },
+    /// Render a morph of built-in generated plates.
+    Demo {
+        #[arg(short = 'o', long = "output", default_value = "morphfx-demo")]
+        output: PathBuf,
+    },
+    /// Draw the node's viewer overlay (its line slots and the scene's
+    /// features) over the plates, as a host's viewer shows them.
+    Overlay {
+        #[command(flatten)]
+        common: Common,
+        /// Source A (with --b: the Morph node's overlay).
+        #[arg(long, conflicts_with = "input")]
+        a: Option<String>,
+        #[arg(long, requires = "a")]
+        b: Option<String>,
+        /// The source of the Warp node's overlay.
+        #[arg(long)]
+        input: Option<String>,
+        /// a, b, both or between: which lines, on which plate (B's for b).
+        #[arg(long, default_value = "both")]
+        show: String,
+    },
+    /// List the plugins in the bundle.
+    Plugins,
+    /// Refine the scene's polylines and curves onto nearby edges of A and B
+    /// with snakes, and write the refined scene.
+    Snap {
+        #[arg(long)]
+        scene: PathBuf,
+        #[arg(long)]
+        a: String,
+        #[arg(long)]
+        b: String,
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// The keyframe to refine (scenes with keyframes), and the frame of
+        /// #-numbered plates.
+        #[arg(long)]
+        frame: Option<f64>,
+        /// Edge smoothing, pixels: edges attract snakes from about twice this.
+        #[arg(long, default_value_t = 3.0)]
+        sigma: f64,
+        /// Iterations of the snake loop.
+        #[arg(long, default_value_t = 200)]
+        iterations: usize,
+        /// Hold the samples on the primitives' control points still.
+        #[arg(long)]
+        clamp_controls: bool,
+    },
+    /// Follow the scene's keyed features through sequence A (and B) and
+    /// write the scene with a keyframe at every frame of the range.
+    Track {
+        #[arg(long)]
+        scene: PathBuf,
+        /// Sequence A, #-numbered (plate.####.exr).
+        #[arg(long)]
+        a: String,
+        /// Sequence B: its features are tracked too; without it they keep
+        /// their keyed (or interpolated) positions.
+        #[arg(long)]
+        b: Option<String>,
+        /// The range to track, FIRST-LAST; it must hold a keyframe.
+        #[arg(long)]
+        frames: String,
+        /// The tracked scene; standard output without it.
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+        /// Half the side of the tracked patch, pixels.
+        #[arg(long, default_value_t = TrackSettings::default().radius)]
+        radius: usize,
+        /// Correlation with the keyed patch below which a feature counts as lost.
+        #[arg(long, default_value_t = TrackSettings::default().min_correlation)]
+        min_correlation: f64,
+    },
+    /// Time a whole sequence morph on generated plates (EXR IO included) and
+    /// say where the time went.
+    Bench {
+        #[arg(short = 'o', long = "output", default_value = "morphfx-bench")]
+        output: PathBuf,
+        #[arg(long, default_value_t = 48)]
+        frames: usize,
+        #[arg(long, default_value_t = 1920)]
+        width: usize,
+        #[arg(long, default_value_t = 1080)]
+        height: usize,
+    },
+}
