@@ -4,7 +4,9 @@
 use morphfx::features::Side;
 use morphfx::geom::Vec2;
 
-use super::params::{slot_clear, slot_group, slot_ids, spec, Reader, LINE_COUNT, LINE_SLOTS};
+use super::params::{
+    slot_clear, slot_group, slot_ids, spec, Id, Point, Reader, SlotIds, LINE_COUNT, LINE_SLOTS,
+};
 use super::NodeKind;
 use crate::wrapper::params::Params;
 use crate::wrapper::spec::Kind;
@@ -32,13 +34,16 @@ impl SlotLine {
 }
 
 /// The param id of slot `slot`'s end `end` (0: start, 1: end) on `side`.
-pub fn end_id(slot: usize, side: Side, end: usize) -> String {
-    let [_, a0, a1, b0, b1] = slot_ids(slot);
-    match (side, end) {
-        (Side::A, 0) => a0,
-        (Side::A, _) => a1,
-        (Side::B, 0) => b0,
-        (Side::B, _) => b1,
+pub fn end_id(slot: usize, side: Side, end: usize) -> Id<Point> {
+    let SlotIds { a, b, .. } = slot_ids(slot);
+    let [start, stop] = match side {
+        Side::A => a,
+        Side::B => b,
+    };
+    if end == 0 {
+        start
+    } else {
+        stop
     }
 }
 
@@ -46,12 +51,12 @@ pub fn end_id(slot: usize, side: Side, end: usize) -> String {
 /// zero-length ones (a line being drawn starts with no length).
 pub fn slot_lines(r: &Reader<'_>) -> Vec<SlotLine> {
     let mut lines = Vec::new();
-    for k in 1..=(r.int(LINE_COUNT).max(0) as usize).min(LINE_SLOTS) {
-        let [enable, a0, a1, b0, b1] = slot_ids(k);
-        if !r.bool(&enable) {
+    for k in 1..=(r.int(&LINE_COUNT).max(0) as usize).min(LINE_SLOTS) {
+        let ids = slot_ids(k);
+        if !r.bool(&ids.enable) {
             continue;
         }
-        let ends = [&a0, &a1, &b0, &b1].map(|id| r.point(id));
+        let ends = ids.ends().map(|id| r.point(id));
         if let [Some(a0), Some(a1), Some(b0), Some(b1)] = ends {
             if [a0, a1, b0, b1].iter().all(|p| p.is_finite()) {
                 lines.push(SlotLine {
@@ -69,31 +74,31 @@ pub fn slot_lines(r: &Reader<'_>) -> Vec<SlotLine> {
 /// defaults, and it is turned off; a trailing run of disabled slots leaves
 /// Line Count. One undo step.
 pub fn clear(kind: NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
-    let [enable, ..] = slot_ids(k);
+    let enable = slot_ids(k).enable;
     params.edit_block(&format!("Clear Line {k}"), || {
         for side in [Side::A, Side::B] {
             for end in 0..2 {
                 let id = end_id(k, side, end);
                 // A host without keyframes (or without this call) has no
                 // keys to delete: the value below is all there is.
-                let _ = params.delete_all_keys(&id);
-                params.set_point(&id, default_point(kind, &id))?;
+                let _ = params.delete_all_keys(id.name());
+                params.set_point(id.name(), default_point(kind, &id))?;
             }
         }
-        params.set_int(&enable, 0)?;
+        params.set_int(enable.name(), 0)?;
         let r = Reader::new(params, kind, time);
-        let mut count = r.int(LINE_COUNT).max(0) as usize;
-        while count > 0 && !r.bool(&slot_ids(count)[0]) {
+        let mut count = r.int(&LINE_COUNT).max(0) as usize;
+        while count > 0 && !r.bool(&slot_ids(count).enable) {
             count -= 1;
         }
-        params.set_int(LINE_COUNT, count as i32)
+        params.set_int(LINE_COUNT.name(), count as i32)
     })?;
     hide_unused(kind, params, time);
     Ok(())
 }
 
-fn default_point(kind: NodeKind, id: &str) -> (f64, f64) {
-    match spec(kind, id).map(|p| &p.kind) {
+fn default_point(kind: NodeKind, id: &Id<Point>) -> (f64, f64) {
+    match spec(kind, id.name()).map(|p| &p.kind) {
         Some(Kind::Point { default }) => *default,
         _ => (0.0, 0.0),
     }
@@ -102,11 +107,11 @@ fn default_point(kind: NodeKind, id: &str) -> (f64, f64) {
 /// Shows the slots up to Line Count and hides the rest. Best effort: a
 /// host that cannot hide params shows them all, which is only untidy.
 pub fn hide_unused(kind: NodeKind, params: &Params, time: f64) {
-    let count = Reader::new(params, kind, time).int(LINE_COUNT).max(0) as usize;
+    let count = Reader::new(params, kind, time).int(&LINE_COUNT).max(0) as usize;
     for k in 1..=LINE_SLOTS {
         let secret = k > count;
         let _ = params.set_secret(&slot_group(k), secret);
-        for id in slot_ids(k).iter().chain([&slot_clear(k)]) {
+        for id in slot_ids(k).names().iter().chain([&slot_clear(k)]) {
             let _ = params.set_secret(id, secret);
         }
     }

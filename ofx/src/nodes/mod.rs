@@ -174,13 +174,13 @@ impl<N: Node> ImageEffect for N {
 /// A param changed: the buttons act, Line Count shows its slots.
 fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) -> Outcome {
     let (name, time) = (change.name.as_str(), change.time);
-    if name == params::SNAP_LINES {
+    if name == params::SNAP_LINES.name() {
         snap::snap_lines(node, effect, time)
-    } else if name == params::TRACK_FORWARD {
+    } else if name == params::TRACK_FORWARD.name() {
         track::track_lines(node, effect, time, 1)
-    } else if name == params::TRACK_BACKWARD {
+    } else if name == params::TRACK_BACKWARD.name() {
         track::track_lines(node, effect, time, -1)
-    } else if name == params::LINE_COUNT {
+    } else if name == params::LINE_COUNT.name() {
         lines::hide_unused(node.kind, node.params(), time);
         Ok(())
     } else if let Some(k) = params::clear_button_slot(name) {

@@ -8,7 +8,7 @@ use morphfx::features::FeatureKind;
 use morphfx::geom::{PixelScale, Vec2};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 
-use super::params::{slot_ids, Reader, Settings, LINE_COUNT, SNAP_SIGMA};
+use super::params::{slot_ids, Reader, Settings, SlotIds, LINE_COUNT, SNAP_SIGMA};
 use super::NodeState;
 use crate::wrapper::clips::{Depth, EffectHandle};
 use crate::wrapper::{Failure, Outcome};
@@ -19,7 +19,7 @@ pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
     let params = instance.params();
     let settings = Settings::read(params, time, kind);
     let r = Reader::new(params, kind, time);
-    let sigma = r.double(SNAP_SIGMA);
+    let sigma = r.double(&SNAP_SIGMA);
     let (a, b) = kind.source_clips(instance.context);
     let energy_a = edge_energy(effect, a, time + settings.offset_a as f64, sigma)?;
     let energy_b = match b {
@@ -31,19 +31,18 @@ pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
         )?),
         None => None,
     };
-    let count = r.int(LINE_COUNT) as usize;
+    let count = r.int(&LINE_COUNT) as usize;
     // Every endpoint's new key first, then all written as one undo step.
     let mut keys = Vec::new();
     for k in 1..=count {
-        let [enable, a0, a1, b0, b1] = slot_ids(k);
+        let SlotIds { enable, a, b } = slot_ids(k);
         if !r.bool(&enable) {
             continue;
         }
-        let sides =
-            std::iter::once((a0, a1, &energy_a)).chain(energy_b.as_ref().map(|e| (b0, b1, e)));
-        for (start, end, (energy, scale)) in sides {
-            let p = Vec2::from(<[f64; 2]>::from(params.point(&start, time)?));
-            let q = Vec2::from(<[f64; 2]>::from(params.point(&end, time)?));
+        let sides = std::iter::once((a, &energy_a)).chain(energy_b.as_ref().map(|e| (b, e)));
+        for ([start, end], (energy, scale)) in sides {
+            let p = Vec2::from(<[f64; 2]>::from(params.point(start.name(), time)?));
+            let q = Vec2::from(<[f64; 2]>::from(params.point(end.name(), time)?));
             if p == q || !(p.is_finite() && q.is_finite()) {
                 continue;
             }
@@ -53,7 +52,7 @@ pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
     }
     params.edit_block("Snap Lines", || {
         keys.iter()
-            .try_for_each(|(id, p)| params.set_point_at(id, time, (p.x, p.y)))
+            .try_for_each(|(id, p)| params.set_point_at(id.name(), time, (p.x, p.y)))
     })?;
     instance.purge();
     Ok(())

@@ -157,7 +157,7 @@ fn stop_frame(
         .flat_map(|(side, _)| lines.iter().map(move |l| (l.slot, *side)))
         .flat_map(|(slot, side)| (0..2).map(move |end| end_id(slot, side, end)))
         // A host that cannot list keys: the clip's end decides.
-        .flat_map(|id| params.key_times(&id).unwrap_or_default())
+        .flat_map(|id| params.key_times(id.name()).unwrap_or_default())
         .filter(|t| (t - time) * dir > 0.5)
         .min_by(|x, y| ((x - time) * dir).total_cmp(&((y - time) * dir)));
     if let Some(key) = next_key {
@@ -210,7 +210,7 @@ fn sweep(
                 }
                 for (end, p) in e.points.iter().enumerate() {
                     let at = Vec2::new(p.x / scale.x, p.y / scale.y);
-                    params.set_point_at(&end_id(f.slot, f.side, end), frame, (at.x, at.y))?;
+                    params.set_point_at(end_id(f.slot, f.side, end).name(), frame, (at.x, at.y))?;
                 }
             }
         }

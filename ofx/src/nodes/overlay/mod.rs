@@ -102,12 +102,12 @@ impl<N: Node> Overlay<N> for SlotOverlay {
 /// The params every overlay redraw depends on (the interact is slaved to them).
 fn slave_params() -> Vec<String> {
     let mut ids = vec![
-        LINE_COUNT.to_owned(),
-        OVERLAY_SHOW.to_owned(),
-        OVERLAY_EDIT.to_owned(),
+        LINE_COUNT.name().to_owned(),
+        OVERLAY_SHOW.name().to_owned(),
+        OVERLAY_EDIT.name().to_owned(),
     ];
     for k in 1..=LINE_SLOTS {
-        ids.extend(slot_ids(k));
+        ids.extend(slot_ids(k).names());
     }
     ids
 }
@@ -125,7 +125,7 @@ fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Out
         lock(&instance.overlay).measured_pixel = Some(pixel);
     }
     let params = instance.params();
-    let show: Show = Reader::new(params, kind, time).choice(OVERLAY_SHOW);
+    let show: Show = Reader::new(params, kind, time).choice(&OVERLAY_SHOW);
     if show == Show::Off {
         return Ok(Reply::Done);
     }
@@ -192,7 +192,7 @@ fn editable(edit: EditSides, show: Show, state: &State) -> Vec<Side> {
 /// What the pen can reach at `pen.time`: the slots and the grabbable sides.
 fn reach(kind: NodeKind, params: &Params, state: &State, time: f64) -> (Vec<SlotLine>, Vec<Side>) {
     let r = Reader::new(params, kind, time);
-    let sides = editable(r.choice(OVERLAY_EDIT), r.choice(OVERLAY_SHOW), state);
+    let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), state);
     (slot_lines(&r), sides)
 }
 
@@ -223,7 +223,7 @@ fn pen_down(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
                 }
             }
             None => {
-                let count = Reader::new(params, kind, pen.time).int(LINE_COUNT);
+                let count = Reader::new(params, kind, pen.time).int(&LINE_COUNT);
                 if count as usize >= LINE_SLOTS {
                     return Ok(Reply::Default);
                 }
@@ -239,8 +239,8 @@ fn pen_down(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
         Drag::Move { handle, .. } => params.begin_edit(&format!("Move Line {}", handle.slot))?,
         Drag::New { slot, .. } => {
             params.begin_edit(&format!("New Line {slot}"))?;
-            params.set_int(LINE_COUNT, slot as i32)?;
-            params.set_int(&slot_ids(slot)[0], 1)?;
+            params.set_int(LINE_COUNT.name(), slot as i32)?;
+            params.set_int(slot_ids(slot).enable.name(), 1)?;
         }
     }
     lock(&instance.overlay).drag = Some(drag);
@@ -255,19 +255,19 @@ fn write_drag(params: &Params, drag: Drag, pen: Pen) -> Outcome {
         Drag::Move { handle, from, ends } => {
             let id = |end| end_id(handle.slot, handle.side, end);
             match handle.part {
-                Part::Start => params.move_point(&id(0), pen.time, xy(pen.at)),
-                Part::End => params.move_point(&id(1), pen.time, xy(pen.at)),
+                Part::Start => params.move_point(id(0).name(), pen.time, xy(pen.at)),
+                Part::End => params.move_point(id(1).name(), pen.time, xy(pen.at)),
                 Part::Middle => {
                     let d = pen.at - from;
-                    params.move_point(&id(0), pen.time, xy(ends[0] + d))?;
-                    params.move_point(&id(1), pen.time, xy(ends[1] + d))
+                    params.move_point(id(0).name(), pen.time, xy(ends[0] + d))?;
+                    params.move_point(id(1).name(), pen.time, xy(ends[1] + d))
                 }
             }
         }
         Drag::New { slot, start, .. } => {
             for side in [Side::A, Side::B] {
-                params.move_point(&end_id(slot, side, 0), pen.time, xy(start))?;
-                params.move_point(&end_id(slot, side, 1), pen.time, xy(pen.at))?;
+                params.move_point(end_id(slot, side, 0).name(), pen.time, xy(start))?;
+                params.move_point(end_id(slot, side, 1).name(), pen.time, xy(pen.at))?;
             }
             Ok(())
         }
@@ -314,7 +314,7 @@ fn pen_up(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
             count_before,
             ..
         } if screen_length(start, pen.at, pixel) < MIN_NEW_LINE_PX => {
-            params.set_int(LINE_COUNT, count_before)
+            params.set_int(LINE_COUNT.name(), count_before)
         }
         _ => write_drag(params, drag, pen),
     };

@@ -99,7 +99,7 @@ pub(super) fn pattern_label(p: Option<PatternKind>) -> &'static str {
 
 /// How the field is evaluated (the tolerance is its own param).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum EvaluationMode {
+pub enum EvaluationMode {
     Adaptive,
     Exact,
 }
@@ -116,7 +116,7 @@ impl Choice for EvaluationMode {
 
 /// What a procedural transition paces.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Affects {
+pub enum Affects {
     Both,
     Geometry,
     Colour,

@@ -1,47 +1,119 @@
-//! The params' ids: stable names hosts save projects by.
+//! The params' ids: stable names hosts save projects by, each typed with
+//! the kind of value the param holds, so every read and write through an id
+//! is checked when the plugin is compiled.
+
+use std::borrow::Cow;
+use std::marker::PhantomData;
+
+use morphfx::image::{EdgeMode, Filter};
+use morphfx::warp::field::LineInterpolation;
+use morphfx::warp::mesh::Pass;
+
+use super::choices::{Affects, EditSides, EvaluationMode, Show};
+
+/// A param's id, typed with the kind of value it holds (`Double`, `Int`,
+/// `Bool`, `Text`, `Point`, `Choose<C>`, `Indexed`, `Button`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Id<K> {
+    name: Cow<'static, str>,
+    kind: PhantomData<fn() -> K>,
+}
+
+impl<K> Id<K> {
+    pub const fn new(name: &'static str) -> Self {
+        Id {
+            name: Cow::Borrowed(name),
+            kind: PhantomData,
+        }
+    }
+
+    fn owned(name: String) -> Self {
+        Id {
+            name: Cow::Owned(name),
+            kind: PhantomData,
+        }
+    }
+
+    /// The id as hosts know it.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+impl<K> From<Id<K>> for String {
+    fn from(id: Id<K>) -> String {
+        id.name.into_owned()
+    }
+}
+
+/// A floating-point param.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Double;
+/// An integer param.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Int;
+/// A boolean param.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bool;
+/// A string param.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Text;
+/// A canonical position (Double2D).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Point;
+/// A push button: it has no value, only presses.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Button;
+/// A choice whose options are `C`'s, in `Choice::ALL` order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Choose<C>(PhantomData<C>);
+/// A choice whose options depend on the node (methods, views, patterns):
+/// read by index into the list the table defined it with.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Indexed;
 
 /// Line-pair slots every node offers (a face takes 30 to 60 lines).
 pub const LINE_SLOTS: usize = 64;
 
-pub const METHOD: &str = "method";
-pub const PROGRESS: &str = "progress";
-pub const USE_SCENE_PROGRESS: &str = "use_scene_progress";
-pub const SETTINGS_FROM_SCENE: &str = "settings_from_scene";
-pub const FIELD_A: &str = "field_a";
-pub const FIELD_B: &str = "field_b";
-pub const FIELD_P: &str = "field_p";
-pub const INTERPOLATION: &str = "line_interpolation";
-pub const EVALUATION: &str = "evaluation";
-pub const TOLERANCE: &str = "tolerance";
-pub const LINE_COUNT: &str = "line_count";
-pub const SCENE_FILE: &str = "scene_file";
-pub const SCENE_TEXT: &str = "scene_text";
-pub const OFFSET_A: &str = "frame_offset_a";
-pub const OFFSET_B: &str = "frame_offset_b";
-pub const FILTER: &str = "filter";
-pub const EDGE: &str = "edge";
-pub const VIEW: &str = "view";
-pub const MESH_PASS: &str = "mesh_pass";
-pub const SNAP_LINES: &str = "snap_lines";
-pub const SNAP_SIGMA: &str = "snap_sigma";
-pub const TRACK_FORWARD: &str = "track_forward";
-pub const TRACK_BACKWARD: &str = "track_backward";
-pub const OVERLAY_SHOW: &str = "overlay_show";
-pub const OVERLAY_EDIT: &str = "overlay_edit";
-pub const AUTO_LEVELS: &str = "auto_levels";
-pub const AUTO_COLOUR: &str = "auto_colour";
-pub const AUTO_STRETCH: &str = "auto_stretch";
-pub const AUTO_ANGLE: &str = "auto_angle";
-pub const AUTO_ANCHORS: &str = "auto_anchors";
-pub const AUTO_WARM_START: &str = "auto_warm_start";
-pub const PLATE_ALPHA: &str = "plate_alpha";
-pub const PLATE_BETA: &str = "plate_beta";
-pub const MFFD_ALPHA: &str = "mffd_alpha";
-pub const TRANSITION: &str = "transition";
-pub const TRANSITION_AFFECTS: &str = "transition_affects";
-pub const TRANSITION_SPREAD: &str = "transition_spread";
-pub const TRANSITION_ANGLE: &str = "transition_angle";
-pub const TRANSITION_CYCLES: &str = "transition_cycles";
+pub const METHOD: Id<Indexed> = Id::new("method");
+pub const PROGRESS: Id<Double> = Id::new("progress");
+pub const USE_SCENE_PROGRESS: Id<Bool> = Id::new("use_scene_progress");
+pub const SETTINGS_FROM_SCENE: Id<Bool> = Id::new("settings_from_scene");
+pub const FIELD_A: Id<Double> = Id::new("field_a");
+pub const FIELD_B: Id<Double> = Id::new("field_b");
+pub const FIELD_P: Id<Double> = Id::new("field_p");
+pub const INTERPOLATION: Id<Choose<LineInterpolation>> = Id::new("line_interpolation");
+pub const EVALUATION: Id<Choose<EvaluationMode>> = Id::new("evaluation");
+pub const TOLERANCE: Id<Double> = Id::new("tolerance");
+pub const LINE_COUNT: Id<Int> = Id::new("line_count");
+pub const SCENE_FILE: Id<Text> = Id::new("scene_file");
+pub const SCENE_TEXT: Id<Text> = Id::new("scene_text");
+pub const OFFSET_A: Id<Int> = Id::new("frame_offset_a");
+pub const OFFSET_B: Id<Int> = Id::new("frame_offset_b");
+pub const FILTER: Id<Choose<Filter>> = Id::new("filter");
+pub const EDGE: Id<Choose<EdgeMode>> = Id::new("edge");
+pub const VIEW: Id<Indexed> = Id::new("view");
+pub const MESH_PASS: Id<Choose<Pass>> = Id::new("mesh_pass");
+pub const SNAP_LINES: Id<Button> = Id::new("snap_lines");
+pub const SNAP_SIGMA: Id<Double> = Id::new("snap_sigma");
+pub const TRACK_FORWARD: Id<Button> = Id::new("track_forward");
+pub const TRACK_BACKWARD: Id<Button> = Id::new("track_backward");
+pub const OVERLAY_SHOW: Id<Choose<Show>> = Id::new("overlay_show");
+pub const OVERLAY_EDIT: Id<Choose<EditSides>> = Id::new("overlay_edit");
+pub const AUTO_LEVELS: Id<Int> = Id::new("auto_levels");
+pub const AUTO_COLOUR: Id<Double> = Id::new("auto_colour");
+pub const AUTO_STRETCH: Id<Double> = Id::new("auto_stretch");
+pub const AUTO_ANGLE: Id<Double> = Id::new("auto_angle");
+pub const AUTO_ANCHORS: Id<Double> = Id::new("auto_anchors");
+pub const AUTO_WARM_START: Id<Bool> = Id::new("auto_warm_start");
+pub const PLATE_ALPHA: Id<Double> = Id::new("plate_alpha");
+pub const PLATE_BETA: Id<Double> = Id::new("plate_beta");
+pub const MFFD_ALPHA: Id<Double> = Id::new("mffd_alpha");
+pub const TRANSITION: Id<Indexed> = Id::new("transition");
+pub const TRANSITION_AFFECTS: Id<Choose<Affects>> = Id::new("transition_affects");
+pub const TRANSITION_SPREAD: Id<Double> = Id::new("transition_spread");
+pub const TRANSITION_ANGLE: Id<Double> = Id::new("transition_angle");
+pub const TRANSITION_CYCLES: Id<Double> = Id::new("transition_cycles");
 
 /// The group holding line slot `k`'s params.
 pub fn slot_group(k: usize) -> String {
@@ -63,16 +135,38 @@ pub fn clear_button_slot(id: &str) -> Option<usize> {
     (1..=LINE_SLOTS).contains(&k).then_some(k)
 }
 
-/// Ids of line slot `k` (1-based): enable, A start, A end, B start, B end.
-pub fn slot_ids(k: usize) -> [String; 5] {
-    [
-        format!("line{k}_enable"),
-        format!("line{k}_a_start"),
-        format!("line{k}_a_end"),
-        format!("line{k}_b_start"),
-        format!("line{k}_b_end"),
-    ]
+/// Line slot `k`'s params (1-based): its switch and the ends of its lines.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SlotIds {
+    pub enable: Id<Bool>,
+    /// A's start and end.
+    pub a: [Id<Point>; 2],
+    /// B's start and end.
+    pub b: [Id<Point>; 2],
+}
+
+impl SlotIds {
+    /// Every position of the slot: A's start and end, then B's.
+    pub fn ends(&self) -> [&Id<Point>; 4] {
+        [&self.a[0], &self.a[1], &self.b[0], &self.b[1]]
+    }
+
+    /// The slot's ids as hosts know them, switch first.
+    pub fn names(&self) -> [String; 5] {
+        let [a0, a1, b0, b1] = self.ends().map(|id| id.name().to_owned());
+        [self.enable.name().to_owned(), a0, a1, b0, b1]
+    }
+}
+
+/// Line slot `k`'s ids.
+pub fn slot_ids(k: usize) -> SlotIds {
+    let point = |which: &str| Id::owned(format!("line{k}_{which}"));
+    SlotIds {
+        enable: Id::owned(format!("line{k}_enable")),
+        a: [point("a_start"), point("a_end")],
+        b: [point("b_start"), point("b_end")],
+    }
 }
 
 /// The transition context's mandated param (`kOfxImageEffectTransitionParamName`).
-pub const TRANSITION_PARAM: &str = "Transition";
+pub const TRANSITION_PARAM: Id<Double> = Id::new("Transition");

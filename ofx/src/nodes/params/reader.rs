@@ -10,6 +10,7 @@ use crate::wrapper::params::Params;
 use crate::wrapper::spec::{Kind, ParamSpec};
 use crate::wrapper::Outcome;
 
+use super::ids::{Bool, Choose, Double, Id, Indexed, Int, Point, Text};
 use super::table::spec;
 
 /// Reads params at one time, each by the table entry that defines it: the
@@ -56,7 +57,8 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn double(&self, id: &str) -> f64 {
+    pub fn double(&self, id: &Id<Double>) -> f64 {
+        let id = id.name();
         let Kind::Double {
             default, min, max, ..
         } = self.spec(id).kind
@@ -69,7 +71,8 @@ impl<'a> Reader<'a> {
         }
     }
 
-    pub fn int(&self, id: &str) -> i32 {
+    pub fn int(&self, id: &Id<Int>) -> i32 {
+        let id = id.name();
         let Kind::Int { default, min, max } = self.spec(id).kind else {
             panic!("param {id} is not an integer");
         };
@@ -77,7 +80,8 @@ impl<'a> Reader<'a> {
             .map_or(default, |v| v.clamp(min, max))
     }
 
-    pub fn bool(&self, id: &str) -> bool {
+    pub fn bool(&self, id: &Id<Bool>) -> bool {
+        let id = id.name();
         let Kind::Bool { default } = self.spec(id).kind else {
             panic!("param {id} is not a boolean");
         };
@@ -87,7 +91,11 @@ impl<'a> Reader<'a> {
 
     /// The option of `options` the host's index picks (the list the table
     /// defined the param with), else the declared default.
-    pub(super) fn pick<C: Copy>(&self, id: &str, options: &[C]) -> C {
+    pub fn pick<C: Copy>(&self, id: &Id<Indexed>, options: &[C]) -> C {
+        self.index(id.name(), options)
+    }
+
+    fn index<C: Copy>(&self, id: &str, options: &[C]) -> C {
         let Kind::Choice { default, .. } = &self.spec(id).kind else {
             panic!("param {id} is not a choice");
         };
@@ -99,11 +107,12 @@ impl<'a> Reader<'a> {
     }
 
     /// A [`Choice`] param, defined with its options in [`Choice::ALL`] order.
-    pub fn choice<C: Choice>(&self, id: &str) -> C {
-        self.pick(id, C::ALL)
+    pub fn choice<C: Choice>(&self, id: &Id<Choose<C>>) -> C {
+        self.index(id.name(), C::ALL)
     }
 
-    pub fn text(&self, id: &str) -> String {
+    pub fn text(&self, id: &Id<Text>) -> String {
+        let id = id.name();
         let Kind::Text { default, .. } = self.spec(id).kind else {
             panic!("param {id} is not text");
         };
@@ -112,7 +121,8 @@ impl<'a> Reader<'a> {
     }
 
     /// A position param, `None` when the host cannot give it.
-    pub fn point(&self, id: &str) -> Option<Vec2> {
+    pub fn point(&self, id: &Id<Point>) -> Option<Vec2> {
+        let id = id.name();
         let Kind::Point { .. } = self.spec(id).kind else {
             panic!("param {id} is not a position");
         };

@@ -62,19 +62,19 @@ impl Settings {
 
     fn read_with(r: Reader<'_>, kind: NodeKind) -> Settings {
         let warp = MethodSettings {
-            method: r.pick(METHOD, methods(kind)),
+            method: r.pick(&METHOD, methods(kind)),
             field: field_settings(&r),
             mesh: MeshSettings {
-                pass: r.choice(MESH_PASS),
+                pass: r.choice(&MESH_PASS),
             },
             auto: auto_settings(&r),
             thin_plate: ThinPlateSettings {
-                alpha: r.double(PLATE_ALPHA),
-                beta: r.double(PLATE_BETA),
+                alpha: r.double(&PLATE_ALPHA),
+                beta: r.double(&PLATE_BETA),
                 ..ThinPlateSettings::default()
             },
             mffd: MffdSettings {
-                alpha: r.double(MFFD_ALPHA),
+                alpha: r.double(&MFFD_ALPHA),
                 ..MffdSettings::default()
             },
             transition: transition_settings(&r),
@@ -82,21 +82,21 @@ impl Settings {
         };
         let settings = Settings {
             warp,
-            progress: r.double(PROGRESS),
-            use_scene_progress: r.bool(USE_SCENE_PROGRESS),
-            settings_from_scene: r.bool(SETTINGS_FROM_SCENE),
+            progress: r.double(&PROGRESS),
+            use_scene_progress: r.bool(&USE_SCENE_PROGRESS),
+            settings_from_scene: r.bool(&SETTINGS_FROM_SCENE),
             lines: lines(&r),
-            scene_file: r.text(SCENE_FILE),
-            scene_text: r.text(SCENE_TEXT),
-            offset_a: r.int(OFFSET_A),
+            scene_file: r.text(&SCENE_FILE),
+            scene_text: r.text(&SCENE_TEXT),
+            offset_a: r.int(&OFFSET_A),
             offset_b: if kind == NodeKind::Morph {
-                r.int(OFFSET_B)
+                r.int(&OFFSET_B)
             } else {
                 0
             },
-            filter: r.choice(FILTER),
-            edge: r.choice(EDGE),
-            view: r.pick(VIEW, views(kind)),
+            filter: r.choice(&FILTER),
+            edge: r.choice(&EDGE),
+            view: r.pick(&VIEW, views(kind)),
             missing: Vec::new(),
             unreadable: Vec::new(),
         };
@@ -109,17 +109,17 @@ impl Settings {
 }
 
 pub(super) fn field_settings(r: &Reader<'_>) -> FieldSettings {
-    let evaluation = match r.choice(EVALUATION) {
+    let evaluation = match r.choice(&EVALUATION) {
         EvaluationMode::Exact => Evaluation::Exact,
         EvaluationMode::Adaptive => Evaluation::Adaptive {
-            tolerance: r.double(TOLERANCE),
+            tolerance: r.double(&TOLERANCE),
         },
     };
     FieldSettings {
-        a: r.double(FIELD_A),
-        b: r.double(FIELD_B),
-        p: r.double(FIELD_P),
-        interpolation: r.choice(INTERPOLATION),
+        a: r.double(&FIELD_A),
+        b: r.double(&FIELD_B),
+        p: r.double(&FIELD_P),
+        interpolation: r.choice(&INTERPOLATION),
         evaluation,
         ..FieldSettings::default()
     }
@@ -128,29 +128,29 @@ pub(super) fn field_settings(r: &Reader<'_>) -> FieldSettings {
 pub(super) fn auto_settings(r: &Reader<'_>) -> AutoSettings {
     AutoSettings {
         // 0: the level that gives quads of about 4 pixels.
-        levels: match r.int(AUTO_LEVELS) {
+        levels: match r.int(&AUTO_LEVELS) {
             0 => None,
             l => Some(l as u32),
         },
         coefficients: Coefficients {
-            colour: r.double(AUTO_COLOUR),
-            stretch: r.double(AUTO_STRETCH),
-            angle: r.double(AUTO_ANGLE),
-            anchor: r.double(AUTO_ANCHORS),
+            colour: r.double(&AUTO_COLOUR),
+            stretch: r.double(&AUTO_STRETCH),
+            angle: r.double(&AUTO_ANGLE),
+            anchor: r.double(&AUTO_ANCHORS),
         },
-        warm_start: r.bool(AUTO_WARM_START),
+        warm_start: r.bool(&AUTO_WARM_START),
         ..AutoSettings::default()
     }
 }
 
 pub(super) fn transition_settings(r: &Reader<'_>) -> TransitionSettings {
-    let Some(kind) = r.pick(TRANSITION, &PATTERNS) else {
+    let Some(kind) = r.pick(&TRANSITION, &PATTERNS) else {
         return TransitionSettings::default();
     };
-    let cycles = r.double(TRANSITION_CYCLES);
+    let cycles = r.double(&TRANSITION_CYCLES);
     let pattern = match kind {
         PatternKind::Ramp => Pattern::Ramp {
-            angle: r.double(TRANSITION_ANGLE),
+            angle: r.double(&TRANSITION_ANGLE),
         },
         PatternKind::SineRows => Pattern::SineRows { cycles },
         PatternKind::SineColumns => Pattern::SineColumns { cycles },
@@ -161,9 +161,9 @@ pub(super) fn transition_settings(r: &Reader<'_>) -> TransitionSettings {
     };
     let t = Transition::Procedural(Procedural {
         pattern,
-        spread: r.double(TRANSITION_SPREAD),
+        spread: r.double(&TRANSITION_SPREAD),
     });
-    match r.choice(TRANSITION_AFFECTS) {
+    match r.choice(&TRANSITION_AFFECTS) {
         Affects::Both => TransitionSettings {
             geometry: t,
             colour: None,

@@ -186,7 +186,11 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
 
 /// Line slot `k`'s params, in their own group: enable, the four ends, Clear.
 pub(super) fn slot_specs(k: usize) -> Vec<ParamSpec> {
-    let [enable, a0, a1, b0, b1] = slot_ids(k);
+    let SlotIds {
+        enable,
+        a: [a0, a1],
+        b: [b0, b1],
+    } = slot_ids(k);
     let group = slot_group(k);
     // Default lines stacked down the frame, so slots added one by one in a
     // host without the overlay do not all start on top of each other.

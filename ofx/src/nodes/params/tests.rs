@@ -19,7 +19,7 @@ use crate::nodes::NodeKind;
 const RELEASED: &[(NodeKind, &str, &[&str])] = &[
     (
         NodeKind::Morph,
-        METHOD,
+        "method",
         &[
             "field",
             "mesh",
@@ -32,12 +32,12 @@ const RELEASED: &[(NodeKind, &str, &[&str])] = &[
     ),
     (
         NodeKind::Warp,
-        METHOD,
+        "method",
         &["field", "mesh", "triangles", "thin-plate", "mffd", "hybrid"],
     ),
     (
         NodeKind::Morph,
-        VIEW,
+        "view",
         &[
             "morph",
             "warped-a",
@@ -48,29 +48,29 @@ const RELEASED: &[(NodeKind, &str, &[&str])] = &[
             "grid",
         ],
     ),
-    (NodeKind::Warp, VIEW, &["warped", "stmap", "grid"]),
+    (NodeKind::Warp, "view", &["warped", "stmap", "grid"]),
 ];
 
 /// Choice params both nodes share, with their released options.
 const RELEASED_BOTH: &[(&str, &[&str])] = &[
-    (INTERPOLATION, &["endpoints", "center-angle"]),
-    (EVALUATION, &["adaptive", "exact"]),
-    (MESH_PASS, &["two-pass", "one-pass"]),
+    ("line_interpolation", &["endpoints", "center-angle"]),
+    ("evaluation", &["adaptive", "exact"]),
+    ("mesh_pass", &["two-pass", "one-pass"]),
     (
-        TRANSITION,
+        "transition",
         &["uniform", "ramp", "sine-rows", "sine-columns", "radial"],
     ),
     (
-        TRANSITION_AFFECTS,
+        "transition_affects",
         &["geometry and colour", "geometry", "colour"],
     ),
-    (FILTER, &["bilinear", "bicubic"]),
-    (EDGE, &["clamp", "black", "mirror"]),
+    ("filter", &["bilinear", "bicubic"]),
+    ("edge", &["clamp", "black", "mirror"]),
     (
-        OVERLAY_SHOW,
+        "overlay_show",
         &["A and B", "A only", "B only", "in-between", "off"],
     ),
-    (OVERLAY_EDIT, &["A and B", "A only", "B only"]),
+    ("overlay_edit", &["A and B", "A only", "B only"]),
 ];
 
 fn released() -> Vec<(NodeKind, &'static str, &'static [&'static str])> {
@@ -124,15 +124,15 @@ fn every_choice_param_is_recorded_with_a_default_among_its_options() {
 #[test]
 fn choices_read_back_the_option_they_label() {
     for kind in [NodeKind::Morph, NodeKind::Warp] {
-        let (labels, _) = options(kind, METHOD).expect("method");
+        let (labels, _) = options(kind, METHOD.name()).expect("method");
         let names: Vec<_> = methods(kind).iter().map(|m| m.name()).collect();
         assert_eq!(labels, names);
-        let (labels, _) = options(kind, VIEW).expect("view");
+        let (labels, _) = options(kind, VIEW.name()).expect("view");
         let names: Vec<_> = views(kind).iter().map(|v| view_label(kind, *v)).collect();
         assert_eq!(labels, names);
     }
     assert_eq!(
-        options(NodeKind::Morph, EDGE).expect("edge").0,
+        options(NodeKind::Morph, EDGE.name()).expect("edge").0,
         EdgeMode::names()
     );
 }

@@ -87,7 +87,7 @@ pub(in crate::nodes) fn warp_inputs(
     if instance.kind == NodeKind::Morph && instance.context == Context::Transition {
         t = instance
             .params()
-            .double(TRANSITION_PARAM, time)?
+            .double(TRANSITION_PARAM.name(), time)?
             .clamp(0.0, 1.0);
     }
     Ok(WarpInputs { features, warp, t })

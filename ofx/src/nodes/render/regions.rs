@@ -25,9 +25,9 @@ fn source_times(node: &NodeState, time: f64) -> impl Iterator<Item = (&'static s
 /// The frame offsets of the sources (params read without a settings pass).
 fn offsets(node: &NodeState, time: f64) -> (f64, f64) {
     let r = Reader::new(node.params(), node.kind, time);
-    let a = r.int(OFFSET_A) as f64;
+    let a = r.int(&OFFSET_A) as f64;
     let b = if node.kind == NodeKind::Morph {
-        r.int(OFFSET_B) as f64
+        r.int(&OFFSET_B) as f64
     } else {
         0.0
     };
