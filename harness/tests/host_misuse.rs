@@ -524,3 +524,24 @@ fn a_param_the_host_made_with_another_type_is_never_written_through_the_wrong_va
         }
     }
 }
+
+#[test]
+fn an_instance_sent_to_another_plugins_entry_is_refused_not_cast() {
+    let (_armed, b) = host(&[]);
+    let inst = warp(&b);
+    let args = render_args();
+    // A Warp instance handed to the Morph node's main entry: the plugin
+    // finds no Morph there and says so, rather than reading a Warp as one.
+    let (status, messages) = inst
+        .send_via(
+            "net.morphfx.Morph",
+            kOfxImageEffectActionRender,
+            Some(&args),
+        )
+        .unwrap();
+    assert_eq!(status, kOfxStatErrBadHandle);
+    let text = error_text(&messages, "render through the wrong entry");
+    assert!(text.contains("not a net.morphfx.Morph node"), "{text}");
+    // The instance itself is unharmed.
+    picture(&inst);
+}

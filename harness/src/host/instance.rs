@@ -404,6 +404,37 @@ impl Instance<'_> {
         (status, messages)
     }
 
+    /// Sends `action` on this instance through another plugin's main entry
+    /// (`plugin`, an id of the same bundle), as a host that mixed up its
+    /// handles would: the plugin's status and the messages it posted.
+    pub fn send_via(
+        &self,
+        plugin: &str,
+        action: &CStr,
+        in_args: Option<&PropertySet>,
+    ) -> Result<(OfxStatus, Vec<Message>), HostError> {
+        let other = self
+            .bundle
+            .plugins
+            .iter()
+            .find(|p| p.id == plugin)
+            .ok_or_else(|| HostError::bad(format!("no plugin {plugin} in the bundle")))?;
+        self.effect.take_messages();
+        let handle = self.effect.handle() as *const c_void;
+        let status = self
+            .bundle
+            .call(other.plugin, action, handle, in_args, None);
+        let mut messages = self.effect.take_messages();
+        messages.extend(
+            self.effect
+                .persistent
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take(),
+        );
+        Ok((status, messages))
+    }
+
     fn sequence_args(first: f64, last: f64) -> PropertySet {
         let a = PropertySet::new();
         a.set_double(kOfxImageEffectPropFrameRange, &[first, last]);
