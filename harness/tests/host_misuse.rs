@@ -39,8 +39,8 @@ fn host(misuses: &[Misuse]) -> (Armed, Bundle) {
     (armed, bundle)
 }
 
-/// A Warp node over a 32 × 24 gradient with one line pair that moves.
-fn warp(bundle: &Bundle) -> Instance<'_> {
+/// A Warp node over a 32 × 24 gradient, no line set.
+fn gradient_warp(bundle: &Bundle) -> Instance<'_> {
     let inst = bundle
         .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
         .unwrap();
@@ -54,6 +54,12 @@ fn warp(bundle: &Bundle) -> Instance<'_> {
     let frame = Arc::new(Frame::from_image(&img, "OfxBitDepthFloat", false));
     inst.connect("Source", Arc::new(Still(frame))).unwrap();
     inst.set_project(32.0, 24.0);
+    inst
+}
+
+/// A Warp node over a 32 × 24 gradient with one line pair that moves.
+fn warp(bundle: &Bundle) -> Instance<'_> {
+    let inst = gradient_warp(bundle);
     inst.set_int("line_count", 1).unwrap();
     for (id, v) in [
         ("a_start", [4.0, 4.0]),
@@ -448,19 +454,7 @@ fn refuses_param_of_wrong_type(
     act: fn(&Instance) -> String,
 ) {
     let (_armed, bundle) = host(&[Misuse::ParamType(param, wrong)]);
-    let inst = bundle
-        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
-        .unwrap();
-    let img = Image::from_fn(RectI::from_size(32, 24), 4, |i, j, c| {
-        if c == 3 {
-            1.0
-        } else {
-            (i + 2 * j + c as i32) as f32 * 0.01
-        }
-    });
-    let frame = Arc::new(Frame::from_image(&img, "OfxBitDepthFloat", false));
-    inst.connect("Source", Arc::new(Still(frame))).unwrap();
-    inst.set_project(32.0, 24.0);
+    let inst = gradient_warp(&bundle);
     if param != "line_count" {
         inst.set_int("line_count", 1).unwrap();
     }

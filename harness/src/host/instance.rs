@@ -393,6 +393,12 @@ impl Instance<'_> {
         let status = self
             .bundle
             .call(self.plugin, action, handle, in_args, out_args);
+        (status, self.messages_posted())
+    }
+
+    /// The messages the plugin posted on the instance since they were last
+    /// taken, its persistent one taken too.
+    fn messages_posted(&self) -> Vec<Message> {
         let mut messages = self.effect.take_messages();
         messages.extend(
             self.effect
@@ -401,7 +407,7 @@ impl Instance<'_> {
                 .unwrap_or_else(|e| e.into_inner())
                 .take(),
         );
-        (status, messages)
+        messages
     }
 
     /// Sends `action` on this instance through another plugin's main entry
@@ -424,15 +430,7 @@ impl Instance<'_> {
         let status = self
             .bundle
             .call(other.plugin, action, handle, in_args, None);
-        let mut messages = self.effect.take_messages();
-        messages.extend(
-            self.effect
-                .persistent
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .take(),
-        );
-        Ok((status, messages))
+        Ok((status, self.messages_posted()))
     }
 
     fn sequence_args(first: f64, last: f64) -> PropertySet {
