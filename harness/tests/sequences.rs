@@ -146,6 +146,21 @@ fn a_sequence_render_equals_single_frame_renders_whatever_the_chunking() {
             );
         }
     }
+    // Farms' stepped ranges and lists render exactly the frames they name,
+    // each as the sequence render made it.
+    render("1001-1004x3", "stepped.####.exr");
+    render("1001-1004:2,1004", "colon.####.exr");
+    for (out, frames) in [("stepped", [1001, 1004]), ("colon", [1001, 1003])] {
+        for f in 1001..=1004 {
+            let path = d.join(format!("{out}.{f}.exr"));
+            let named = frames.contains(&f) || (out == "colon" && f == 1004);
+            assert_eq!(path.exists(), named, "{out}: frame {f}");
+            if named {
+                let whole = io::read(&d.join(format!("whole.{f}.exr"))).unwrap().image;
+                assert_eq!(io::read(&path).unwrap().image, whole, "{out}: frame {f}");
+            }
+        }
+    }
     // The in-between frames really are in between (not a copy of A or B).
     let mid = io::read(&d.join("whole.1002.exr")).unwrap().image;
     let a = io::read(&d.join("a.1002.exr")).unwrap().image;
