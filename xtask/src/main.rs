@@ -1,10 +1,12 @@
 //! Developer tasks: `cargo xtask bundle [--release]`, `cargo xtask demo [-o DIR]`,
-//! `cargo xtask test`, `cargo xtask refhost` (the reference host check alone).
+//! `cargo xtask test`, `cargo xtask refhost` (the reference host check alone),
+//! `cargo xtask farm` (the Open Job Description check alone).
 //! Builds the plugin bundle first so the harness finds it.
 
 use std::path::{Path, PathBuf};
 use std::process::{exit, Command};
 
+mod farm;
 mod refhost;
 mod tools;
 
@@ -135,6 +137,7 @@ fn main() {
             println!("bundle: {}", b.display());
         }
         Some("refhost") => refhost::check(&bundle(false)),
+        Some("farm") => farm::check(&morphfx_binary(), &bundle(false)),
         Some("demo") => {
             let b = bundle(true);
             let status = morphfx(true, &b)
@@ -157,15 +160,29 @@ fn main() {
             release_concurrency(&b);
             docs();
             refhost::check(&b);
+            farm::check(&morphfx_binary(), &b);
             cmake_install_check();
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask bundle [--release] | demo [-o DIR] | test [cargo test args] | refhost"
+                "usage: cargo xtask bundle [--release] | demo [-o DIR] | test [cargo test args] | refhost | farm"
             );
             exit(2);
         }
     }
+}
+
+/// The `morphfx` binary of the dev profile, built if need be.
+fn morphfx_binary() -> PathBuf {
+    cargo(&[
+        "build",
+        "--quiet",
+        "--package",
+        "morphfx-harness",
+        "--bin",
+        "morphfx",
+    ]);
+    target_dir().join("debug").join("morphfx")
 }
 
 /// The concurrency test again with the plugin and the test built in the

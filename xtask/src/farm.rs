@@ -1,0 +1,287 @@
+//! The farm check: the Open Job Description templates in `farm/openjd/`,
+//! validated and run by the reference runtime (`openjd-cli` from PyPI, in a
+//! virtual environment under `target/`) exactly as a farm worker runs them,
+//! a 12-frame shot in chunks of 5 held pixel for pixel (byte for byte) to
+//! one `morphfx` call over the same frames.
+
+use std::path::{Path, PathBuf};
+use std::process::{exit, Command, Output};
+
+use crate::{root, target_dir, tools};
+
+/// The reference runtime, pinned: what this check was written against.
+const OPENJD: [&str; 3] = [
+    "openjd-cli==0.8.0",
+    "openjd-model==0.13.0",
+    "openjd-sessions==0.13.0",
+];
+
+/// Frames of the generated shot, and the chunk size the farm run uses.
+const FRAMES: &str = "1-12";
+const CHUNK: &str = "5";
+
+/// Runs the check; says SKIPPED (and why) when Python or PyPI cannot be
+/// had, and exits the test command on any failure.
+pub fn check(morphfx: &Path, bundle: &Path) {
+    let openjd = match runtime() {
+        Ok(openjd) => openjd,
+        Err(why) => {
+            println!("farm check (Open Job Description): SKIPPED ({why})");
+            return;
+        }
+    };
+    let templates = root().join("farm").join("openjd");
+    for name in ["morph", "warp"] {
+        let template = templates.join(format!("{name}.template.yaml"));
+        expect_ok(
+            &run(&openjd, &["check".as_ref(), template.as_os_str()]),
+            "openjd check",
+        );
+    }
+    let dir = target_dir().join("farm-check");
+    let _ = std::fs::remove_dir_all(&dir);
+    let shot = Shot::make(morphfx, bundle, &dir);
+    let folder = bundle.parent().expect("the bundle lies in a folder");
+    let mut chunks = 0;
+    for (node, inputs) in [
+        ("morph", vec![("A", shot.a.clone()), ("B", shot.b.clone())]),
+        ("warp", vec![("Input", shot.a.clone())]),
+    ] {
+        let single = dir.join(format!("{node}-single"));
+        shot.single(node, &single);
+        let farm = dir.join(format!("{node}-farm"));
+        let template = templates.join(format!("{node}.template.yaml"));
+        let mut params = shot.params(folder, &farm);
+        params.extend(inputs);
+        let out = openjd_run(&openjd, &template, &params);
+        expect_ok(&out, &format!("openjd run {node}"));
+        chunks += count_chunks(&out);
+        same_frames(&single, &farm, node);
+    }
+    refusals(
+        &openjd,
+        &templates.join("morph.template.yaml"),
+        &shot,
+        folder,
+        &dir,
+    );
+    println!(
+        "farm check (Open Job Description {}): both templates valid; a {FRAMES} shot in \
+         chunks of {CHUNK} ({chunks} chunks, morph and warp) equals one morphfx call byte for \
+         byte; a failing chunk and a bad ChunkSize fail the run",
+        OPENJD[0]
+    );
+}
+
+/// A failing chunk fails the run, and a parameter outside the template's
+/// own constraints is refused before anything runs.
+fn refusals(openjd: &Path, template: &Path, shot: &Shot, folder: &Path, dir: &Path) {
+    let missing = dir.join("missing");
+    let mut params = shot.params(folder, &missing);
+    params.push(("A", dir.join("no-such-plate.####.exr")));
+    params.push(("B", shot.b.clone()));
+    let out = openjd_run(openjd, template, &params);
+    if out.status.success() {
+        fail(
+            "openjd run succeeded though every chunk's morphfx call failed",
+            &out,
+        );
+    }
+    let mut params = shot.params(folder, &missing);
+    params.retain(|(k, _)| *k != "ChunkSize");
+    params.push(("ChunkSize", PathBuf::from("0")));
+    params.push(("A", shot.a.clone()));
+    params.push(("B", shot.b.clone()));
+    let out = openjd_run(openjd, template, &params);
+    let text = String::from_utf8_lossy(&out.stdout) + String::from_utf8_lossy(&out.stderr);
+    if out.status.success() || !text.contains("must be at least 1") {
+        fail(
+            "openjd run took ChunkSize=0, which the template's minValue forbids",
+            &out,
+        );
+    }
+    if missing.exists() && std::fs::read_dir(&missing).is_ok_and(|mut d| d.next().is_some()) {
+        eprintln!(
+            "farm check FAILED: a refused run wrote into {}",
+            missing.display()
+        );
+        exit(1);
+    }
+}
+
+/// The shot both runs render: plate sequences A and B and a keyframed
+/// scene, made by `morphfx bench` at a small size.
+struct Shot {
+    morphfx: PathBuf,
+    bundle: PathBuf,
+    scene: PathBuf,
+    a: PathBuf,
+    b: PathBuf,
+}
+
+impl Shot {
+    fn make(morphfx: &Path, bundle: &Path, dir: &Path) -> Shot {
+        let out = Command::new(morphfx)
+            .arg("--bundle")
+            .arg(bundle)
+            .args([
+                "bench", "--frames", "12", "--width", "96", "--height", "64", "-o",
+            ])
+            .arg(dir.join("shot"))
+            .output()
+            .expect("morphfx runs");
+        expect_ok(&out, "morphfx bench (making the shot)");
+        let plates = dir.join("shot").join("plates");
+        Shot {
+            morphfx: morphfx.to_path_buf(),
+            bundle: bundle.to_path_buf(),
+            scene: dir.join("shot").join("bench.morph.json"),
+            a: plates.join("a.####.exr"),
+            b: plates.join("b.####.exr"),
+        }
+    }
+
+    /// One `morphfx` call over every frame, as a user runs it.
+    fn single(&self, node: &str, out: &Path) {
+        let mut c = Command::new(&self.morphfx);
+        c.arg("--bundle")
+            .arg(&self.bundle)
+            .arg(node)
+            .arg("--scene")
+            .arg(&self.scene);
+        if node == "morph" {
+            c.arg("--a").arg(&self.a).arg("--b").arg(&self.b);
+        } else {
+            c.arg("--input").arg(&self.a);
+        }
+        c.args(["--frames", FRAMES, "-o"])
+            .arg(out.join("f.####.exr"));
+        expect_ok(
+            &c.output().expect("morphfx runs"),
+            &format!("morphfx {node}"),
+        );
+    }
+
+    /// The job parameters every run shares (inputs aside).
+    fn params(&self, plugin_path: &Path, out: &Path) -> Vec<(&'static str, PathBuf)> {
+        vec![
+            ("Morphfx", self.morphfx.clone()),
+            ("PluginPath", plugin_path.to_path_buf()),
+            ("Scene", self.scene.clone()),
+            ("Output", out.join("f.####.exr")),
+            ("Frames", PathBuf::from(FRAMES)),
+            ("ChunkSize", PathBuf::from(CHUNK)),
+        ]
+    }
+}
+
+/// `openjd` in a virtual environment under `target/`, installed from PyPI
+/// with pinned versions the first time.
+fn runtime() -> Result<PathBuf, String> {
+    let venv = target_dir().join("openjd-venv");
+    let openjd = venv.join("bin").join("openjd");
+    let pinned = venv.join("pinned.txt");
+    if openjd.is_file() && std::fs::read_to_string(&pinned).is_ok_and(|p| p == OPENJD.join("\n")) {
+        return Ok(openjd);
+    }
+    if !tools::runs("python3", &["--version"]) {
+        return Err("no python3".into());
+    }
+    let _ = std::fs::remove_dir_all(&venv);
+    let made = Command::new("python3")
+        .args(["-m", "venv"])
+        .arg(&venv)
+        .output()
+        .map_err(|e| format!("python3 -m venv: {e}"))?;
+    if !made.status.success() {
+        return Err(format!(
+            "python3 -m venv failed: {}",
+            String::from_utf8_lossy(&made.stderr).trim()
+        ));
+    }
+    println!(
+        "installing {} into {} (pip)...",
+        OPENJD.join(" "),
+        venv.display()
+    );
+    let pip = Command::new(venv.join("bin").join("pip"))
+        .args(["install", "--quiet", "--disable-pip-version-check"])
+        .args(OPENJD)
+        .output()
+        .map_err(|e| format!("pip: {e}"))?;
+    if !pip.status.success() {
+        return Err(format!(
+            "pip could not install the runtime (PyPI unreachable?): {}",
+            String::from_utf8_lossy(&pip.stderr).trim()
+        ));
+    }
+    std::fs::write(&pinned, OPENJD.join("\n")).expect("write pinned.txt");
+    Ok(openjd)
+}
+
+fn run(openjd: &Path, args: &[&std::ffi::OsStr]) -> Output {
+    Command::new(openjd)
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("openjd runs")
+}
+
+fn openjd_run(openjd: &Path, template: &Path, params: &[(&str, PathBuf)]) -> Output {
+    let mut c = Command::new(openjd);
+    c.arg("run").arg(template);
+    for (k, v) in params {
+        c.arg("-p").arg(format!("{k}={}", v.display()));
+    }
+    c.current_dir(root()).output().expect("openjd runs")
+}
+
+/// How many chunks a local session ran, from its summary.
+fn count_chunks(out: &Output) -> usize {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Chunks run:"))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+/// Every frame of the single run, and no other, written by the farm run
+/// with the same bytes.
+fn same_frames(single: &Path, farm: &Path, node: &str) {
+    let names = |dir: &Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .map(|d| {
+                d.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    };
+    let (a, b) = (names(single), names(farm));
+    if a.len() != 12 || a != b {
+        eprintln!("farm check FAILED ({node}): one call wrote {a:?}, the farm run {b:?}");
+        exit(1);
+    }
+    for f in &a {
+        let (x, y) = (std::fs::read(single.join(f)), std::fs::read(farm.join(f)));
+        if x.ok() != y.ok() {
+            eprintln!("farm check FAILED ({node}): {f} differs between one call and the farm run");
+            exit(1);
+        }
+    }
+}
+
+fn expect_ok(out: &Output, what: &str) {
+    if !out.status.success() {
+        fail(&format!("{what} failed ({})", out.status), out);
+    }
+}
+
+fn fail(what: &str, out: &Output) -> ! {
+    eprintln!("{}", String::from_utf8_lossy(&out.stdout));
+    eprintln!("{}", String::from_utf8_lossy(&out.stderr));
+    eprintln!("farm check FAILED: {what}");
+    exit(1);
+}
