@@ -177,6 +177,11 @@ pub enum Command {
         #[arg(long, default_value_t = TrackSettings::default().min_correlation)]
         min_correlation: f64,
     },
+    /// Write a farm job for a morph or warp command line.
+    Job {
+        #[command(subcommand)]
+        kind: JobKind,
+    },
     /// Time a whole sequence morph on generated plates (EXR IO included) and
     /// say where the time went.
     Bench {
@@ -189,4 +194,120 @@ pub enum Command {
         #[arg(long, default_value_t = 1080)]
         height: usize,
     },
+}
+
+#[derive(Subcommand)]
+pub enum JobKind {
+    /// An Open Job Description job bundle (template.yaml with the command's
+    /// values as defaults, parameter_values.yaml as Deadline Cloud takes
+    /// them): `morphfx job openjd -o DIR -- morph --scene S --a A --b B
+    /// --frames 1001-1048 -o OUT`.
+    Openjd {
+        /// The job bundle's folder.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// Frames per chunk (one morphfx call each).
+        #[arg(long, default_value_t = 10)]
+        chunk_size: u32,
+        /// Seconds a chunk should take (the scheduler then sizes chunks);
+        /// 0 keeps chunks of --chunk-size frames.
+        #[arg(long, default_value_t = 0)]
+        chunk_target_runtime: u32,
+        /// The morphfx command on the workers (a path is made absolute).
+        #[arg(long, default_value = "morphfx")]
+        morphfx: String,
+        /// The command line to run: `morph ...` or `warp ...`.
+        #[arg(last = true, required = true)]
+        command: Vec<String>,
+    },
+}
+
+/// The command line with each `--extra-args "A B C"` (before a bare `--`)
+/// replaced by its words: how a farm template, which hands a program a
+/// fixed list of arguments, passes a job's further options.
+pub fn expand_extra_args(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut out = Vec::new();
+    let mut args = args.into_iter();
+    while let Some(arg) = args.next() {
+        if arg == "--" {
+            out.push(arg);
+            out.extend(args.by_ref());
+            break;
+        }
+        let words = if arg == "--extra-args" {
+            args.next()
+        } else {
+            arg.to_str()
+                .and_then(|a| a.strip_prefix("--extra-args="))
+                .map(Into::into)
+        };
+        match words {
+            Some(w) => out.extend(
+                w.to_string_lossy()
+                    .split_whitespace()
+                    .map(std::ffi::OsString::from),
+            ),
+            None if arg == "--extra-args" => {}
+            None => out.push(arg),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn expand(args: &[&str]) -> Vec<String> {
+        expand_extra_args(args.iter().map(std::ffi::OsString::from))
+            .into_iter()
+            .map(|a| a.into_string().unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn extra_args_become_words_of_the_command_line() {
+        assert_eq!(
+            expand(&[
+                "morphfx",
+                "morph",
+                "--extra-args",
+                " --t 0.5  --half",
+                "-o",
+                "x"
+            ]),
+            ["morphfx", "morph", "--t", "0.5", "--half", "-o", "x"]
+        );
+        assert_eq!(
+            expand(&["morphfx", "warp", "--extra-args=", "-o", "x"]),
+            ["morphfx", "warp", "-o", "x"]
+        );
+        assert_eq!(
+            expand(&["morphfx", "warp", "--extra-args"]),
+            ["morphfx", "warp"]
+        );
+        // After a bare `--` everything is the job's own command line.
+        assert_eq!(
+            expand(&[
+                "morphfx",
+                "job",
+                "openjd",
+                "--",
+                "morph",
+                "--extra-args",
+                "--t 1"
+            ]),
+            [
+                "morphfx",
+                "job",
+                "openjd",
+                "--",
+                "morph",
+                "--extra-args",
+                "--t 1"
+            ]
+        );
+    }
 }

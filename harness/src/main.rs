@@ -4,15 +4,15 @@
 
 use clap::Parser;
 use morphfx::snake::SnakeSettings;
-use morphfx_harness::cli::{Cli, Command};
-use morphfx_harness::commands::{bench, demo, find_bundle, job, overlay, plugins, track};
+use morphfx_harness::cli::{Cli, Command, JobKind};
+use morphfx_harness::commands::{bench, demo, find_bundle, job, openjd, overlay, plugins, track};
 use morphfx_harness::host::{ErrorKind, HostError};
 use morphfx_harness::interrupt;
 use morphfx_harness::snap::Snap;
 
 fn main() {
     morphfx_harness::host::allocator::tune_for_frames();
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(morphfx_harness::cli::expand_extra_args(std::env::args_os()));
     interrupt::install();
     if cli.verbose {
         // The plugin is told through its environment (set before it is
@@ -97,6 +97,23 @@ fn run(cli: Cli) -> Result<(), HostError> {
             radius,
             min_correlation,
         ),
+        Command::Job {
+            kind:
+                JobKind::Openjd {
+                    output,
+                    chunk_size,
+                    chunk_target_runtime,
+                    morphfx,
+                    command,
+                },
+        } => openjd::write_bundle(&openjd::Job {
+            dir: &output,
+            chunk_size,
+            chunk_target_runtime,
+            morphfx: &morphfx,
+            plugin_path: cli.bundle.as_deref(),
+            command: &command,
+        }),
         Command::Bench {
             output,
             frames,

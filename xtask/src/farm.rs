@@ -2,7 +2,8 @@
 //! validated and run by the reference runtime (`openjd-cli` from PyPI, in a
 //! virtual environment under `target/`) exactly as a farm worker runs them,
 //! a 12-frame shot in chunks of 5 held pixel for pixel (byte for byte) to
-//! one `morphfx` call over the same frames.
+//! one `morphfx` call over the same frames; and the job bundle `morphfx job
+//! openjd` writes, run as it says.
 
 use std::path::{Path, PathBuf};
 use std::process::{exit, Command, Output};
@@ -58,6 +59,7 @@ pub fn check(morphfx: &Path, bundle: &Path) {
         chunks += count_chunks(&out);
         same_frames(&single, &farm, node);
     }
+    chunks += job_bundle(&openjd, &shot, &dir);
     refusals(
         &openjd,
         &templates.join("morph.template.yaml"),
@@ -67,10 +69,51 @@ pub fn check(morphfx: &Path, bundle: &Path) {
     );
     println!(
         "farm check (Open Job Description {}): both templates valid; a {FRAMES} shot in \
-         chunks of {CHUNK} ({chunks} chunks, morph and warp) equals one morphfx call byte for \
-         byte; a failing chunk and a bad ChunkSize fail the run",
+         chunks of {CHUNK} ({chunks} chunks: morph, warp, and a `morphfx job openjd` bundle \
+         with an extra option) equals one morphfx call byte for byte; a failing chunk and a \
+         bad ChunkSize fail the run",
         OPENJD[0]
     );
+}
+
+/// `morphfx job openjd` for a morph with an option the template carries as
+/// an extra argument (`--half`), run as its bundle says: the same bytes as
+/// one call with that option. The chunks it ran.
+fn job_bundle(openjd: &Path, shot: &Shot, dir: &Path) -> usize {
+    let (job, farm, single) = (
+        dir.join("job"),
+        dir.join("job-farm"),
+        dir.join("job-single"),
+    );
+    let out = Command::new(&shot.morphfx)
+        .arg("--bundle")
+        .arg(&shot.bundle)
+        .args(["job", "openjd", "--chunk-size", CHUNK, "--morphfx"])
+        .arg(&shot.morphfx)
+        .arg("-o")
+        .arg(&job)
+        .args(["--", "morph", "--scene"])
+        .arg(&shot.scene)
+        .arg("--a")
+        .arg(&shot.a)
+        .arg("--b")
+        .arg(&shot.b)
+        .args(["--frames", FRAMES, "--half", "-o"])
+        .arg(farm.join("f.####.exr"))
+        .output()
+        .expect("morphfx runs");
+    expect_ok(&out, "morphfx job openjd");
+    let params = format!("file://{}", job.join("openjd_parameters.json").display());
+    let out = Command::new(openjd)
+        .arg("run")
+        .arg(job.join("template.yaml"))
+        .args(["-p", &params])
+        .output()
+        .expect("openjd runs");
+    expect_ok(&out, "openjd run of the job bundle");
+    shot.single_with("morph", &single, &["--half"]);
+    same_frames(&single, &farm, "job bundle");
+    count_chunks(&out)
 }
 
 /// A failing chunk fails the run, and a parameter outside the template's
@@ -143,6 +186,11 @@ impl Shot {
 
     /// One `morphfx` call over every frame, as a user runs it.
     fn single(&self, node: &str, out: &Path) {
+        self.single_with(node, out, &[]);
+    }
+
+    /// The same with `extra` options.
+    fn single_with(&self, node: &str, out: &Path, extra: &[&str]) {
         let mut c = Command::new(&self.morphfx);
         c.arg("--bundle")
             .arg(&self.bundle)
@@ -154,7 +202,8 @@ impl Shot {
         } else {
             c.arg("--input").arg(&self.a);
         }
-        c.args(["--frames", FRAMES, "-o"])
+        c.args(extra)
+            .args(["--frames", FRAMES, "-o"])
             .arg(out.join("f.####.exr"));
         expect_ok(
             &c.output().expect("morphfx runs"),

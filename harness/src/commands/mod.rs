@@ -5,6 +5,7 @@ pub mod bench;
 pub mod demo;
 pub mod job;
 pub mod line_key;
+pub mod openjd;
 pub mod overlay;
 pub mod plates;
 pub mod plugins;
