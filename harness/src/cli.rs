@@ -18,6 +18,11 @@ pub struct Cli {
     /// then the bundle built in this checkout, then /usr/OFX/Plugins.
     #[arg(long, global = true)]
     pub bundle: Option<PathBuf>,
+    /// Folders searched for MorphFX.ofx.bundle before OFX_PLUGIN_PATH
+    /// (separated as PATH is); empty searches none (a farm template passes
+    /// its PluginPath parameter here).
+    #[arg(long, global = true, default_value = "")]
+    pub plugin_path: String,
     /// Say more while rendering (method auto prints its work table per level).
     #[arg(short, long, global = true)]
     pub verbose: bool,

@@ -31,7 +31,7 @@ fn main() {
 fn run(cli: Cli) -> Result<(), HostError> {
     // Looked for by the commands that render; `snap` runs the core's snakes
     // on the plates and needs no bundle.
-    let bundle_path = || find_bundle(cli.bundle.as_deref());
+    let bundle_path = || find_bundle(cli.bundle.as_deref(), &cli.plugin_path);
     match cli.command {
         Command::Plugins => plugins::list_plugins(&bundle_path()?),
         Command::Morph {

@@ -15,12 +15,15 @@ use std::path::{Path, PathBuf};
 
 use crate::host::HostError;
 
-pub fn find_bundle(given: Option<&Path>) -> Result<PathBuf, HostError> {
+pub fn find_bundle(given: Option<&Path>, plugin_path: &str) -> Result<PathBuf, HostError> {
     const NAME: &str = "MorphFX.ofx.bundle";
     if let Some(p) = given {
         return Ok(p.to_path_buf());
     }
     let mut candidates = Vec::new();
+    if !plugin_path.is_empty() {
+        candidates.extend(std::env::split_paths(plugin_path).map(|d| d.join(NAME)));
+    }
     if let Ok(paths) = std::env::var("OFX_PLUGIN_PATH") {
         candidates.extend(std::env::split_paths(&paths).map(|d| d.join(NAME)));
     }
