@@ -294,25 +294,15 @@ mod tests {
             ["morphfx", "warp"]
         );
         // After a bare `--` everything is the job's own command line.
-        assert_eq!(
-            expand(&[
-                "morphfx",
-                "job",
-                "openjd",
-                "--",
-                "morph",
-                "--extra-args",
-                "--t 1"
-            ]),
-            [
-                "morphfx",
-                "job",
-                "openjd",
-                "--",
-                "morph",
-                "--extra-args",
-                "--t 1"
-            ]
-        );
+        let job = [
+            "morphfx",
+            "job",
+            "openjd",
+            "--",
+            "morph",
+            "--extra-args",
+            "--t 1",
+        ];
+        assert_eq!(expand(&job), job);
     }
 }
