@@ -21,9 +21,8 @@ use morphfx::geom::RectD;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::params::Params;
 use crate::wrapper::plugin::{
-    Capabilities, ClipPreferences, ClipSpec, Components, Context, ContextSpec, FrameArgs,
-    FramesNeeded, Identity, ImageEffect, ParamChange, PixelDepth, RenderArgs, RoiArgs, Rois,
-    Sequential, ThreadSafety,
+    Capabilities, ClipPreferences, ClipSpec, Components, Context, ContextSpec, FramesNeeded,
+    Identity, ImageEffect, ParamChange, PixelDepth, RenderArgs, Rois, Sequential, ThreadSafety,
 };
 use crate::wrapper::{Outcome, Reply};
 pub use morph::Morph;
@@ -128,21 +127,17 @@ impl<N: Node> ImageEffect for N {
         self.state().purge();
     }
 
-    fn region_of_definition(
-        &self,
-        effect: &EffectHandle,
-        args: &FrameArgs,
-    ) -> Outcome<Option<RectD>> {
-        render::region_of_definition(self.state(), effect, args)
+    fn region_of_definition(&self, effect: &EffectHandle, time: f64) -> Outcome<Option<RectD>> {
+        render::region_of_definition(self.state(), effect, time)
     }
 
     fn regions_of_interest(
         &self,
         effect: &EffectHandle,
-        args: &RoiArgs,
+        time: f64,
         out: &mut Rois,
     ) -> Outcome<Reply> {
-        render::regions_of_interest(self.state(), effect, args, out)
+        render::regions_of_interest(self.state(), effect, time, out)
     }
 
     fn frames_needed(

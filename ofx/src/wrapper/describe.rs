@@ -20,20 +20,14 @@ pub(super) fn describe<E: ImageEffect>(effect: &EffectHandle) -> Outcome {
     let _ = p.set_string(kOfxPropShortLabel, 0, E::LABEL);
     let _ = p.set_string(kOfxPropPluginDescription, 0, E::DESCRIPTION);
     p.set_string(kOfxImageEffectPluginPropGrouping, 0, E::GROUPING)?;
-    let names = |c: &[&'static CStr]| -> Vec<String> {
-        c.iter().map(|n| n.to_string_lossy().into_owned()).collect()
-    };
-    let contexts = names(&E::CONTEXTS.iter().map(|c| c.name()).collect::<Vec<_>>());
-    p.set_strings(kOfxImageEffectPropSupportedContexts, &strs(&contexts))?;
+    set_names(
+        &p,
+        kOfxImageEffectPropSupportedContexts,
+        E::CONTEXTS.iter().map(|c| c.name()),
+    )?;
     let caps = E::CAPABILITIES;
-    let depths = names(
-        &caps
-            .depths
-            .iter()
-            .map(|d| depth_name(*d))
-            .collect::<Vec<_>>(),
-    );
-    p.set_strings(kOfxImageEffectPropSupportedPixelDepths, &strs(&depths))?;
+    let depths = caps.depths.iter().map(|d| depth_name(*d));
+    set_names(&p, kOfxImageEffectPropSupportedPixelDepths, depths)?;
     // Capabilities: optional for a host to honour, so failures to set them are not fatal.
     let _ = p.set_int(kOfxImageEffectPluginPropSingleInstance, 0, 0);
     let _ = p.set_string(
@@ -88,12 +82,8 @@ pub(super) fn describe_in_context<E: ImageEffect>(
     let ContextSpec { clips, params } = E::describe_in_context(context);
     for spec in clips {
         let clip = effect.define_clip(spec.name)?;
-        let components: Vec<String> = spec
-            .components
-            .iter()
-            .map(|c| components_name(*c).to_string_lossy().into_owned())
-            .collect();
-        clip.set_strings(kOfxImageEffectPropSupportedComponents, &strs(&components))?;
+        let components = spec.components.iter().map(|c| components_name(*c));
+        set_names(&clip, kOfxImageEffectPropSupportedComponents, components)?;
         let _ = clip.set_int(kOfxImageEffectPropSupportsTiles, 0, spec.tiles as i32);
         if spec.name != "Output" {
             let _ = clip.set_int(
@@ -107,8 +97,10 @@ pub(super) fn describe_in_context<E: ImageEffect>(
     effect.param_set()?.define_all(&params)
 }
 
-fn strs(v: &[String]) -> Vec<&str> {
-    v.iter().map(String::as_str).collect()
+/// Sets string property `prop` to the spec's `names`.
+fn set_names(p: &PropSet, prop: &CStr, names: impl Iterator<Item = &'static CStr>) -> Outcome {
+    let names: Vec<String> = names.map(|n| n.to_string_lossy().into_owned()).collect();
+    p.set_strings(prop, &names.iter().map(String::as_str).collect::<Vec<_>>())
 }
 
 fn depth_name(d: PixelDepth) -> &'static CStr {

@@ -7,16 +7,13 @@ use std::ffi::{c_char, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::Ordering;
 
-use morphfx::geom::{RectD, RectI};
+use morphfx::geom::RectI;
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
 
 use super::attach::{attachment, create, detach};
 use super::clips::EffectHandle;
-use super::plugin::{
-    ChangeReason, ClipPreferences, Field, FrameArgs, FramesNeeded, ImageEffect, ParamChange,
-    RenderArgs, RoiArgs, Rois,
-};
+use super::plugin::{ClipPreferences, FramesNeeded, ImageEffect, ParamChange, RenderArgs, Rois};
 use super::props::PropSet;
 use super::{describe, host, Failure, Outcome, Reply, BAD_INPUT_ID};
 
@@ -135,7 +132,10 @@ fn run<E: ImageEffect>(
     } else if action == kOfxActionDestroyInstance {
         detach(&effect)?;
     } else if action == kOfxActionPurgeCaches {
-        attachment(&effect)?.node::<E>()?.purge();
+        with_node(&effect, |n: &E| {
+            n.purge();
+            Ok(())
+        })?;
     } else if action == kOfxImageEffectActionGetRegionOfDefinition {
         return region_of_definition::<E>(&effect, &in_props()?, &out_props()?);
     } else if action == kOfxImageEffectActionGetRegionsOfInterest {
@@ -156,19 +156,14 @@ fn run<E: ImageEffect>(
     Ok(Reply::Done)
 }
 
-fn frame_args(in_args: &PropSet) -> Outcome<FrameArgs> {
-    Ok(FrameArgs {
-        time: in_args.get_double(kOfxPropTime, 0)?,
-        render_scale: render_scale(in_args),
-    })
-}
-
-/// The render scale an action carries, (1, 1) where the host sends none.
-fn render_scale(in_args: &PropSet) -> (f64, f64) {
-    match in_args.get_doubles::<2>(kOfxImageEffectPropRenderScale) {
-        Ok([x, y]) if x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite() => (x, y),
-        _ => (1.0, 1.0),
-    }
+/// Runs `act` on the instance's node, held for the call even if the host
+/// destroys the instance meanwhile.
+fn with_node<E: ImageEffect, R>(
+    effect: &EffectHandle,
+    act: impl FnOnce(&E) -> Outcome<R>,
+) -> Outcome<R> {
+    let attached = attachment(effect)?;
+    act(attached.node::<E>()?)
 }
 
 fn region_of_definition<E: ImageEffect>(
@@ -176,9 +171,8 @@ fn region_of_definition<E: ImageEffect>(
     in_args: &PropSet,
     out_args: &PropSet,
 ) -> Outcome<Reply> {
-    let args = frame_args(in_args)?;
-    let attached = attachment(effect)?;
-    let Some(r) = attached.node::<E>()?.region_of_definition(effect, &args)? else {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let Some(r) = with_node(effect, |n: &E| n.region_of_definition(effect, time))? else {
         return Ok(Reply::Default);
     };
     out_args.set_doubles(
@@ -193,17 +187,11 @@ fn regions_of_interest<E: ImageEffect>(
     in_args: &PropSet,
     out_args: &PropSet,
 ) -> Outcome<Reply> {
-    let [x1, y1, x2, y2] = in_args.get_doubles::<4>(kOfxImageEffectPropRegionOfInterest)?;
-    let args = RoiArgs {
-        time: in_args.get_double(kOfxPropTime, 0)?,
-        render_scale: render_scale(in_args),
-        region: RectD::new(x1, y1, x2, y2),
-    };
+    let time = in_args.get_double(kOfxPropTime, 0)?;
     let mut rois = Rois::default();
-    let attached = attachment(effect)?;
-    let reply = attached
-        .node::<E>()?
-        .regions_of_interest(effect, &args, &mut rois)?;
+    let reply = with_node(effect, |n: &E| {
+        n.regions_of_interest(effect, time, &mut rois)
+    })?;
     for (clip, r) in rois.set {
         let prop = CString::new(format!("OfxImageClipPropRoI_{clip}")).unwrap_or_default();
         out_args.set_doubles(&prop, &[r.x1, r.y1, r.x2, r.y2])?;
@@ -218,10 +206,7 @@ fn frames_needed<E: ImageEffect>(
 ) -> Outcome<Reply> {
     let time = in_args.get_double(kOfxPropTime, 0)?;
     let mut needed = FramesNeeded::default();
-    let attached = attachment(effect)?;
-    let reply = attached
-        .node::<E>()?
-        .frames_needed(effect, time, &mut needed)?;
+    let reply = with_node(effect, |n: &E| n.frames_needed(effect, time, &mut needed))?;
     for (clip, (a, b)) in needed.set {
         let prop = CString::new(format!("OfxImageClipPropFrameRange_{clip}")).unwrap_or_default();
         out_args.set_doubles(&prop, &[a, b])?;
@@ -231,8 +216,7 @@ fn frames_needed<E: ImageEffect>(
 
 fn clip_preferences<E: ImageEffect>(effect: &EffectHandle, out_args: &PropSet) -> Outcome<Reply> {
     let mut prefs = ClipPreferences::default();
-    let attached = attachment(effect)?;
-    let reply = attached.node::<E>()?.clip_preferences(effect, &mut prefs)?;
+    let reply = with_node(effect, |n: &E| n.clip_preferences(effect, &mut prefs))?;
     if let Some(varying) = prefs.frame_varying {
         out_args.set_int(kOfxImageEffectFrameVarying, 0, varying as i32)?;
     }
@@ -254,21 +238,9 @@ fn clip_preferences<E: ImageEffect>(effect: &EffectHandle, out_args: &PropSet) -
 /// A render's or an identity question's arguments.
 fn render_args(in_args: &PropSet) -> Outcome<RenderArgs> {
     let [x1, y1, x2, y2] = in_args.get_ints::<4>(kOfxImageEffectPropRenderWindow)?;
-    let field = in_args
-        .get_string(kOfxImageEffectPropFieldToRender, 0)
-        .unwrap_or_default();
-    let field = if field.as_bytes() == kOfxImageFieldLower.to_bytes() {
-        Field::Lower
-    } else if field.as_bytes() == kOfxImageFieldUpper.to_bytes() {
-        Field::Upper
-    } else {
-        Field::Both
-    };
     Ok(RenderArgs {
         time: in_args.get_double(kOfxPropTime, 0)?,
         window: RectI::new(x1, y1, x2, y2),
-        render_scale: render_scale(in_args),
-        field,
         sequential: in_args
             .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
             .unwrap_or(0)
@@ -282,8 +254,7 @@ fn is_identity<E: ImageEffect>(
     out_args: &PropSet,
 ) -> Outcome<Reply> {
     let args = render_args(in_args)?;
-    let attached = attachment(effect)?;
-    let Some(identity) = attached.node::<E>()?.is_identity(effect, &args)? else {
+    let Some(identity) = with_node(effect, |n: &E| n.is_identity(effect, &args))? else {
         return Ok(Reply::Default);
     };
     out_args.set_string(kOfxPropName, 0, identity.clip)?;
@@ -303,24 +274,11 @@ fn render<E: ImageEffect>(effect: &EffectHandle, in_args: &PropSet) -> Outcome {
 }
 
 fn param_changed<E: ImageEffect>(effect: &EffectHandle, in_args: &PropSet) -> Outcome {
-    let name = in_args.get_string(kOfxPropName, 0)?;
-    let reason = in_args
-        .get_string(kOfxPropChangeReason, 0)
-        .unwrap_or_default();
-    let reason = if reason.as_bytes() == kOfxChangeUserEdited.to_bytes() {
-        ChangeReason::User
-    } else if reason.as_bytes() == kOfxChangePluginEdited.to_bytes() {
-        ChangeReason::Plugin
-    } else {
-        ChangeReason::Other
-    };
     let change = ParamChange {
-        name,
+        name: in_args.get_string(kOfxPropName, 0)?,
         time: in_args.get_double(kOfxPropTime, 0)?,
-        reason,
     };
-    let attached = attachment(effect)?;
-    attached.node::<E>()?.param_changed(effect, &change)
+    with_node(effect, |n: &E| n.param_changed(effect, &change))
 }
 
 /// Actions a host runs on render threads (or may): their failures go to the

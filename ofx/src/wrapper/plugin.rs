@@ -88,39 +88,12 @@ pub struct ContextSpec {
     pub params: Vec<ParamSpec>,
 }
 
-/// The time and render scale of an action that asks about one frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrameArgs {
-    pub time: f64,
-    pub render_scale: (f64, f64),
-}
-
-/// The region-of-interest action: the output region about to be rendered.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RoiArgs {
-    pub time: f64,
-    pub render_scale: (f64, f64),
-    /// Canonical.
-    pub region: RectD,
-}
-
-/// Which field of interlaced footage a render makes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Field {
-    /// Progressive footage, or both fields at once.
-    Both,
-    Lower,
-    Upper,
-}
-
 /// A render or an identity question: one window of one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderArgs {
     pub time: f64,
     /// Pixels.
     pub window: RectI,
-    pub render_scale: (f64, f64),
-    pub field: Field,
     /// The host renders this instance's frames in order (warm starts allowed).
     pub sequential: bool,
 }
@@ -132,23 +105,11 @@ pub struct Identity {
     pub time: f64,
 }
 
-/// Why a param changed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ChangeReason {
-    /// The user edited it.
-    User,
-    /// The plugin set it.
-    Plugin,
-    /// Time moved, or anything else.
-    Other,
-}
-
 /// The instance-changed action for a param.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamChange {
     pub name: String,
     pub time: f64,
-    pub reason: ChangeReason,
 }
 
 /// A region of interest per input clip, set by the node.
@@ -219,16 +180,13 @@ pub trait ImageEffect: Sized + Send + Sync + 'static {
     fn purge(&self) {}
 
     /// The output's region of definition; `None` leaves it to the host's default.
-    fn region_of_definition(
-        &self,
-        effect: &EffectHandle,
-        args: &FrameArgs,
-    ) -> Outcome<Option<RectD>>;
+    fn region_of_definition(&self, effect: &EffectHandle, time: f64) -> Outcome<Option<RectD>>;
 
+    /// Each input's region needed to render the output at `time`.
     fn regions_of_interest(
         &self,
         effect: &EffectHandle,
-        args: &RoiArgs,
+        time: f64,
         out: &mut Rois,
     ) -> Outcome<Reply>;
 

@@ -9,9 +9,7 @@ use super::inputs::{warp_inputs, WarpInputs};
 use crate::nodes::params::{Reader, Settings, OFFSET_A, OFFSET_B};
 use crate::nodes::{NodeKind, NodeState};
 use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::plugin::{
-    ClipPreferences, FrameArgs, FramesNeeded, Identity, RenderArgs, RoiArgs, Rois,
-};
+use crate::wrapper::plugin::{ClipPreferences, FramesNeeded, Identity, RenderArgs, Rois};
 use crate::wrapper::{Outcome, Reply};
 
 /// Each source clip and the time it is read at for output time `time`
@@ -76,9 +74,9 @@ pub(super) fn output_region(
 pub fn region_of_definition(
     node: &NodeState,
     effect: &EffectHandle,
-    args: &FrameArgs,
+    time: f64,
 ) -> Outcome<Option<RectD>> {
-    output_region(node, effect, args.time)
+    output_region(node, effect, time)
 }
 
 /// Clip preferences: the output changes from frame to frame (line slots,
@@ -108,10 +106,10 @@ pub fn clip_preferences(
 pub fn regions_of_interest(
     node: &NodeState,
     effect: &EffectHandle,
-    args: &RoiArgs,
+    time: f64,
     out: &mut Rois,
 ) -> Outcome<Reply> {
-    for (name, at) in source_times(node, args.time) {
+    for (name, at) in source_times(node, time) {
         let clip = effect.clip(name)?;
         if !clip.is_connected() {
             continue;
