@@ -164,4 +164,26 @@ fn a_job_no_template_can_carry_is_refused_and_nothing_is_written() {
         assert!(err.contains(why), "{command:?}: {err}");
         assert!(!job.exists(), "{command:?} wrote {}", job.display());
     }
+    let out = common::run_morphfx(&[
+        "job",
+        "openjd",
+        "-o",
+        &j,
+        "--chunk-size",
+        "0",
+        "--",
+        "warp",
+        "--scene",
+        "s",
+        "--input",
+        "i",
+        "--frames",
+        "1",
+        "-o",
+        "o",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--chunk-size must be at least 1"), "{err}");
+    assert!(!job.exists());
 }

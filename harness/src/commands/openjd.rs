@@ -9,8 +9,11 @@
 
 use std::path::{Path, PathBuf};
 
+use serde_json::Value;
+
 use crate::host::HostError;
 use crate::sequence::parse_frames;
+use crate::snap::write_atomically;
 
 const MORPH_TEMPLATE: &str = include_str!("../../../farm/openjd/morph.template.yaml");
 const WARP_TEMPLATE: &str = include_str!("../../../farm/openjd/warp.template.yaml");
@@ -21,55 +24,34 @@ pub struct Job<'a> {
     pub chunk_size: u32,
     pub chunk_target_runtime: u32,
     pub morphfx: &'a str,
-    /// The bundle `--bundle` named, if any: its folder becomes the workers'
-    /// OFX_PLUGIN_PATH.
+    /// The bundle `--bundle` named, if any: its folder becomes the job's
+    /// PluginPath (`morphfx --plugin-path` on the workers).
     pub plugin_path: Option<&'a Path>,
     /// `morph ...` or `warp ...`.
     pub command: &'a [String],
 }
 
-/// Each job parameter's name and value.
+/// Each job parameter's name and value (a string or an integer).
 type Values = Vec<(&'static str, Value)>;
-
-/// A job parameter's value.
-enum Value {
-    Text(String),
-    Int(u32),
-}
-
-impl Value {
-    /// As YAML writes it (a JSON string is a YAML double-quoted scalar).
-    fn yaml(&self) -> String {
-        match self {
-            Value::Text(t) => serde_json::to_string(t).unwrap_or_default(),
-            Value::Int(n) => n.to_string(),
-        }
-    }
-}
 
 /// Writes the job bundle for `job.command` into `job.dir`.
 pub fn write_bundle(job: &Job) -> Result<(), HostError> {
     let (template, values) = job_values(job)?;
     let mut deadline = String::from("parameterValues:\n");
     for (name, value) in &values {
-        deadline += &format!("  - name: {name}\n    value: {}\n", value.yaml());
+        // A JSON scalar is a YAML one (strings double-quoted).
+        deadline += &format!("  - name: {name}\n    value: {value}\n");
     }
-    let openjd: serde_json::Map<String, serde_json::Value> = values
+    let openjd: serde_json::Map<String, Value> = values
         .iter()
-        .map(|(name, value)| {
-            let v = match value {
-                Value::Text(t) => serde_json::Value::from(t.as_str()),
-                Value::Int(n) => serde_json::Value::from(*n),
-            };
-            (name.to_string(), v)
-        })
+        .map(|(name, value)| (name.to_string(), value.clone()))
         .collect();
     let openjd = serde_json::to_string_pretty(&openjd).unwrap_or_default() + "\n";
     std::fs::create_dir_all(job.dir)
         .map_err(|e| HostError::bad(format!("{}: {e}", job.dir.display())))?;
-    write_text(&job.dir.join("template.yaml"), template)?;
-    write_text(&job.dir.join("parameter_values.yaml"), &deadline)?;
-    write_text(&job.dir.join(OPENJD_PARAMETERS), &openjd)?;
+    write_atomically(&job.dir.join("template.yaml"), template)?;
+    write_atomically(&job.dir.join("parameter_values.yaml"), &deadline)?;
+    write_atomically(&job.dir.join(OPENJD_PARAMETERS), &openjd)?;
     let dir = job.dir.display();
     println!("job bundle: {dir}");
     println!("  run it here:  openjd run {dir}/template.yaml -p file://{dir}/{OPENJD_PARAMETERS}");
@@ -80,20 +62,6 @@ pub fn write_bundle(job: &Job) -> Result<(), HostError> {
 /// The job's values as `openjd run -p file://...` reads them (a map; Deadline
 /// Cloud's `parameter_values.yaml` is a list of names and values).
 pub const OPENJD_PARAMETERS: &str = "openjd_parameters.json";
-
-/// Writes `text` to `path` under a temporary name first, so a failure
-/// leaves no half-written file under the final one.
-fn write_text(path: &Path, text: &str) -> Result<(), HostError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, text)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            HostError::bad(format!("cannot write {}: {e}", path.display()))
-        })
-}
 
 /// The template for the command's node, and every parameter's value.
 fn job_values(job: &Job) -> Result<(&'static str, Values), HostError> {
@@ -110,23 +78,28 @@ fn job_values(job: &Job) -> Result<(&'static str, Values), HostError> {
             )))
         }
     };
+    if job.chunk_size == 0 {
+        return Err(HostError::bad(
+            "morphfx job openjd: --chunk-size must be at least 1",
+        ));
+    }
     let options = Options::parse(args)?;
     let plugin_path = match job.plugin_path {
         Some(p) => absolute(&bundle_folder(p))?,
         None => String::new(),
     };
     let mut values = vec![
-        ("Morphfx", Value::Text(command_path(job.morphfx)?)),
-        ("PluginPath", Value::Text(plugin_path)),
+        ("Morphfx", Value::from(command_path(job.morphfx)?)),
+        ("PluginPath", Value::from(plugin_path)),
         (
             "Scene",
-            Value::Text(absolute(Path::new(options.value("--scene")?))?),
+            Value::from(absolute(Path::new(options.value("--scene")?))?),
         ),
     ];
     for (flag, name) in inputs {
         values.push((
             name,
-            Value::Text(absolute(Path::new(options.value(flag)?))?),
+            Value::from(absolute(Path::new(options.value(flag)?))?),
         ));
     }
     let frames = options.value("--frames")?;
@@ -134,12 +107,12 @@ fn job_values(job: &Job) -> Result<(&'static str, Values), HostError> {
     values.extend([
         (
             "Output",
-            Value::Text(absolute(Path::new(options.value("-o")?))?),
+            Value::from(absolute(Path::new(options.value("-o")?))?),
         ),
-        ("Frames", Value::Text(frames.to_owned())),
-        ("ChunkSize", Value::Int(job.chunk_size.max(1))),
-        ("ChunkTargetRuntime", Value::Int(job.chunk_target_runtime)),
-        ("ExtraArgs", Value::Text(options.extra(inputs)?)),
+        ("Frames", Value::from(frames.to_owned())),
+        ("ChunkSize", Value::from(job.chunk_size)),
+        ("ChunkTargetRuntime", Value::from(job.chunk_target_runtime)),
+        ("ExtraArgs", Value::from(options.extra(inputs)?)),
     ]);
     Ok((template, values))
 }
