@@ -7,6 +7,8 @@ use crate::image::WarpMap;
 use crate::image::{Plane, RowsMut, Sample, Sampler};
 use crate::transition::Weights;
 
+pub mod mix;
+
 /// A warped source as the dissolve reads it: resampled through a reverse
 /// map, or pixels a warp made directly (the two-pass mesh warp).
 #[derive(Clone, Copy)]
@@ -63,7 +65,7 @@ impl<S: Sample> Warped<'_, S> {
 
 impl<S: Sample> Warped<'_, S> {
     /// [`Warped::row`] in `channels` layout.
-    fn row_as(&self, j: i32, x1: i32, channels: usize, out: &mut [[f32; 4]]) {
+    pub fn row_as(&self, j: i32, x1: i32, channels: usize, out: &mut [[f32; 4]]) {
         self.row(j, x1, out);
         let own = self.channels();
         if own != channels {

@@ -5,8 +5,10 @@
 use crate::choice::Choice;
 use crate::features::{sample_points, Feature, FeatureKind};
 use crate::geom::Vec2;
+use crate::image::resample::fill_rows;
 use crate::image::WarpMap;
-use crate::image::{resample::fill, RowsMut, Sample};
+use crate::image::{resample::fill, Image, RowsMut, Sample};
+use crate::morph::Warped;
 use crate::transition::Rates;
 
 /// The output view a node renders (the command line's `--view`, docs/command-line.md).
@@ -27,6 +29,20 @@ pub enum View {
     Transition,
     /// A grid warped like A, to show the warp's shape.
     Grid,
+    /// Where the warped sources disagree (double edges): alpha the mean
+    /// over R, G, B of |warped A − warped B|, colour a heat ramp of it.
+    Ghost,
+    /// Where a reverse map folds the image over itself: alpha 1 there, the
+    /// morph tinted beneath.
+    Folds,
+}
+
+impl View {
+    /// Whether the view is a picture (the morph or a warped source), which
+    /// a mask and mix dial back; the others are maps and diagnostics.
+    pub fn is_picture(self) -> bool {
+        matches!(self, View::Morph | View::WarpedA | View::WarpedB)
+    }
 }
 
 impl Choice for View {
@@ -38,6 +54,8 @@ impl Choice for View {
         View::StmapB,
         View::Transition,
         View::Grid,
+        View::Ghost,
+        View::Folds,
     ];
     fn name(self) -> &'static str {
         match self {
@@ -48,6 +66,8 @@ impl Choice for View {
             View::StmapB => "stmap-b",
             View::Transition => "transition",
             View::Grid => "grid",
+            View::Ghost => "ghost",
+            View::Folds => "folds",
         }
     }
 }
@@ -135,5 +155,86 @@ pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: RowsMut
         if on_feature {
             *px = [1.0, 0.55, 0.1, 1.0];
         }
+    });
+}
+
+/// The ghost view's full scale: a mean difference of this much or more
+/// shows white.
+pub const GHOST_FULL_SCALE: f32 = 0.5;
+
+/// A heat ramp for `v` in `[0, GHOST_FULL_SCALE]`: black, red, yellow,
+/// white, so small residuals already read as dark red.
+pub fn heat(v: f32) -> [f32; 3] {
+    let x = 3.0 * (v / GHOST_FULL_SCALE).clamp(0.0, 1.0);
+    [
+        x.min(1.0),
+        (x - 1.0).clamp(0.0, 1.0),
+        (x - 2.0).clamp(0.0, 1.0),
+    ]
+}
+
+/// The ghost view (Beier-Neely §4's ghosting made measurable): at each pixel
+/// `g` = the mean over R, G, B of |A − B| of the two warped sources, as the
+/// dissolve would add them (premultiplied); written as RGB = [`heat`] of
+/// `g`, alpha = `g`.
+pub fn ghost<S: Sample, D: Sample>(a: Warped<'_, S>, b: Warped<'_, S>, dst: RowsMut<'_, D>) {
+    fill_rows(dst, 4, |j, x1, row, other| {
+        other.resize(row.len(), [0.0; 4]);
+        a.row_as(j, x1, 4, row);
+        b.row_as(j, x1, 4, other);
+        for (pa, pb) in row.iter_mut().zip(other.iter()) {
+            let g = ((pa[0] - pb[0]).abs() + (pa[1] - pb[1]).abs() + (pa[2] - pb[2]).abs()) / 3.0;
+            let [r, gr, bl] = heat(g);
+            *pa = [r, gr, bl, g];
+        }
+    });
+}
+
+/// The Jacobian determinant of a reverse map at pixel `(i, j)`, by central
+/// differences of its positions (one-sided where a neighbour lies outside
+/// its window), in canonical units per pixel squared: ≤ 0 where the map
+/// folds the image over itself or collapses it.
+pub fn jacobian(map: &WarpMap, i: i32, j: i32) -> f64 {
+    let w = map.window;
+    let inside = |i: i32, j: i32| i >= w.x1 && i < w.x2 && j >= w.y1 && j < w.y2;
+    let diff = |(i0, j0): (i32, i32), (i1, j1): (i32, i32)| {
+        let (p0, p1) = match (inside(i0, j0), inside(i1, j1)) {
+            (true, true) => ((i0, j0), (i1, j1)),
+            (false, true) => ((i, j), (i1, j1)),
+            (true, false) => ((i0, j0), (i, j)),
+            (false, false) => return None,
+        };
+        let steps = ((p1.0 - p0.0) + (p1.1 - p0.1)) as f64;
+        Some((map.get(p1.0, p1.1) - map.get(p0.0, p0.1)) * (1.0 / steps))
+    };
+    match (diff((i - 1, j), (i + 1, j)), diff((i, j - 1), (i, j + 1))) {
+        (Some(dx), Some(dy)) => dx.x * dy.y - dx.y * dy.x,
+        _ => 1.0, // a one-pixel map: nothing to measure, nothing folded
+    }
+}
+
+/// Tint of folded pixels over the picture, and how much of it.
+const FOLD_TINT: [f32; 3] = [1.0, 0.0, 1.0];
+const FOLD_TINT_AMOUNT: f32 = 0.6;
+
+/// The folds view: alpha 1 where any of `maps` folds (its Jacobian
+/// determinant ≤ 0), else 0; colour the `picture` (4 channels, covering
+/// `dst`), folded pixels tinted magenta.
+pub fn folds<D: Sample>(picture: &Image, maps: &[&WarpMap], dst: RowsMut<'_, D>) {
+    debug_assert_eq!(picture.channels, 4);
+    fill(dst, 4, |i, j, px| {
+        let p = picture.pixel(i, j);
+        let folded = maps.iter().any(|m| jacobian(m, i, j) <= 0.0);
+        *px = if folded {
+            let k = FOLD_TINT_AMOUNT;
+            [
+                p[0] + (FOLD_TINT[0] - p[0]) * k,
+                p[1] + (FOLD_TINT[1] - p[1]) * k,
+                p[2] + (FOLD_TINT[2] - p[2]) * k,
+                1.0,
+            ]
+        } else {
+            [p[0], p[1], p[2], 0.0]
+        };
     });
 }

@@ -43,6 +43,12 @@ pub struct Common {
     /// Progress t in [0, 1]; overrides the scene's progress keys.
     #[arg(long)]
     pub t: Option<f64>,
+    /// Any node param by its id, as a host would set it: `ID=VALUE`
+    /// (constant) or `ID@FRAME=VALUE` (a key; keys interpolate like a
+    /// host's). Choices by option name, booleans true/false, 2D values
+    /// x,y. `morphfx params` lists the ids. Repeatable.
+    #[arg(long = "param", value_name = "ID=VALUE")]
+    pub param: Vec<String>,
     /// Frames to render, e.g. 1001-1048.
     #[arg(long)]
     pub frames: Option<String>,
@@ -89,9 +95,17 @@ pub enum Command {
         stmap_a: Option<String>,
         #[arg(long = "stmap-b")]
         stmap_b: Option<String>,
-        /// morph, warped-a, warped-b, stmap-a, stmap-b, transition, grid
+        /// morph, warped-a, warped-b, stmap-a, stmap-b, transition, grid, ghost, folds
         #[arg(long, default_value = "morph")]
         view: String,
+        /// The Mask input (file or #-numbered sequence): the morph shows
+        /// where its alpha is, A elsewhere (with the `mix` param).
+        #[arg(long)]
+        mask: Option<String>,
+        /// The Timing input (file or sequence): each pixel of A turns when
+        /// its alpha says, spread by the `transition_spread` param.
+        #[arg(long)]
+        timing: Option<String>,
         /// general or transition
         #[arg(long, default_value = "general")]
         context: String,
@@ -104,9 +118,19 @@ pub enum Command {
         input: String,
         #[arg(long)]
         stmap: Option<String>,
-        /// warped, stmap, grid
+        /// warped, stmap, grid, folds
         #[arg(long, default_value = "warped")]
         view: String,
+        /// The Mask input (file or #-numbered sequence): the warp shows
+        /// where its alpha is, the input elsewhere (with the `mix` param).
+        #[arg(long)]
+        mask: Option<String>,
+    },
+    /// List every param of the nodes: id, type, default and range.
+    Params {
+        /// morph or warp (default: both).
+        #[arg(long)]
+        node: Option<String>,
     },
     /// Render a morph of built-in generated plates.
     Demo {

@@ -5,7 +5,9 @@
 use clap::Parser;
 use morphfx::snake::SnakeSettings;
 use morphfx_harness::cli::{Cli, Command, JobKind};
-use morphfx_harness::commands::{bench, demo, find_bundle, job, openjd, overlay, plugins, track};
+use morphfx_harness::commands::{
+    bench, demo, find_bundle, job, openjd, overlay, params, plugins, track,
+};
 use morphfx_harness::host::{ErrorKind, HostError};
 use morphfx_harness::interrupt;
 use morphfx_harness::snap::Snap;
@@ -41,14 +43,22 @@ fn run(cli: Cli) -> Result<(), HostError> {
             stmap_a,
             stmap_b,
             view,
+            mask,
+            timing,
             context,
-        } => job::morph_job(common, a, b, [stmap_a, stmap_b], view, &context)?.run(&bundle_path()?),
+        } => job::morph_job(common, a, b, [stmap_a, stmap_b], view, &context)?
+            .with_mattes(mask, timing)
+            .run(&bundle_path()?),
         Command::Warp {
             common,
             input,
             stmap,
             view,
-        } => job::warp_job(common, input, stmap, view).run(&bundle_path()?),
+            mask,
+        } => job::warp_job(common, input, stmap, view)
+            .with_mattes(mask, None)
+            .run(&bundle_path()?),
+        Command::Params { node } => params::list_params(&bundle_path()?, node.as_deref()),
         Command::Demo { output } => demo::demo(&bundle_path()?, &output),
         Command::Overlay {
             common,

@@ -9,7 +9,10 @@
 //! on every pair of corresponding points.
 
 pub mod curve;
+pub mod matte;
 pub mod procedural;
+
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -23,6 +26,7 @@ use crate::warp::node_grid::NodeGrid;
 use crate::warp::thin_plate::{ThinPlate, ThinPlateSettings};
 use crate::warp::Warp;
 pub use curve::Curve;
+pub use matte::Matte;
 pub use procedural::{Pattern, Procedural};
 
 /// Where a transition curve is attached on A.
@@ -75,6 +79,14 @@ pub enum Transition {
     },
     /// A pattern over the image, no features needed (Lee et al. §4.2).
     Procedural(Procedural),
+    /// A timing matte: each point's turn is the matte's alpha there, paced
+    /// as a pattern is.
+    Matte {
+        /// The matte, over A.
+        matte: Arc<Matte>,
+        /// The share of the progress over which the turns spread, `[0, 0.99]`.
+        spread: f64,
+    },
 }
 
 /// The geometry transition, and the colour one (`None`: the same as the
@@ -99,6 +111,15 @@ impl TransitionSettings {
 pub enum Rates {
     /// Every point at rate `t`.
     Uniform(f64),
+    /// A timing matte's turns at progress `t`.
+    Matte {
+        /// The matte, over A.
+        matte: Arc<Matte>,
+        /// The share of the progress the turns spread over.
+        spread: f64,
+        /// The progress.
+        t: f64,
+    },
     /// A procedural pattern over `frame` at progress `t`.
     Procedural {
         /// The pattern and its spread.
@@ -135,6 +156,7 @@ impl Rates {
                 frame,
                 t,
             } => return procedural.rate(p, *frame, *t),
+            Rates::Matte { matte, spread, t } => return matte::paced(matte.order(p), *t, *spread),
             Rates::Surface { t, delta } => t + delta.eval(p),
             Rates::Plate { t, delta } => t + delta.displacement(p).x,
         };
@@ -145,6 +167,7 @@ impl Rates {
     pub fn t(&self) -> f64 {
         match self {
             Rates::Uniform(t)
+            | Rates::Matte { t, .. }
             | Rates::Procedural { t, .. }
             | Rates::Surface { t, .. }
             | Rates::Plate { t, .. } => *t,
@@ -169,6 +192,7 @@ impl Transition {
             || match self {
                 Transition::Uniform => true,
                 Transition::Procedural(p) => p.spread == 0.0,
+                Transition::Matte { spread, .. } => *spread == 0.0,
                 Transition::Curves { .. } => false,
             }
     }
@@ -191,6 +215,11 @@ impl Transition {
             Transition::Procedural(procedural) => Ok(Rates::Procedural {
                 procedural: *procedural,
                 frame,
+                t,
+            }),
+            Transition::Matte { matte, spread } => Ok(Rates::Matte {
+                matte: matte.clone(),
+                spread: *spread,
                 t,
             }),
             Transition::Curves {

@@ -131,13 +131,9 @@ impl Procedural {
 
     /// `T(p, t)`.
     pub fn rate(&self, p: Vec2, frame: RectD, t: f64) -> f64 {
-        if t <= 0.0 {
-            return 0.0;
+        if t <= 0.0 || t >= 1.0 {
+            return t.clamp(0.0, 1.0);
         }
-        if t >= 1.0 {
-            return 1.0;
-        }
-        let s = self.spread.clamp(0.0, MAX_SPREAD);
-        ((t - s * self.order(p, frame)) / (1.0 - s)).clamp(0.0, 1.0)
+        super::matte::paced(self.order(p, frame), t, self.spread)
     }
 }

@@ -88,10 +88,12 @@ pub fn bench(
         ],
         view: "morph".into(),
         extra: vec![],
+        mattes: Vec::new(),
         common: Common {
             scene: Some(scene_path),
             line: Vec::new(),
             t: None,
+            param: Vec::new(),
             frames: Some(format!("1-{frames}")),
             output: s(dir.join("morph.####.exr")),
             half: false,

@@ -50,10 +50,12 @@ pub fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
                 ],
                 view: "morph".into(),
                 extra,
+                mattes: Vec::new(),
                 common: Common {
                     scene: Some(path),
                     line: Vec::new(),
                     t: None,
+                    param: Vec::new(),
                     frames: Some("1-12".into()),
                     output: s(output),
                     half: false,

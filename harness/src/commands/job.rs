@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use morphfx::scene::Scene;
 
 use super::line_key::LineKey;
+use super::param_value::ParamSetting;
 use super::plates::Plates;
 use crate::cli::Common;
 use crate::host::{Bundle, HostError, Instance, OutputSpec};
@@ -30,6 +31,7 @@ pub fn warp_job(common: Common, input: String, stmap: Option<String>, view: Stri
         extra: stmap
             .map(|s| vec![("stmap".to_owned(), s)])
             .unwrap_or_default(),
+        mattes: Vec::new(),
         common,
     }
 }
@@ -64,6 +66,7 @@ pub fn morph_job(
             .into_iter()
             .filter_map(|(v, o)| o.map(|o| (v.to_owned(), o)))
             .collect(),
+        mattes: Vec::new(),
         common,
     })
 }
@@ -74,6 +77,9 @@ pub struct Prepared {
     pub lines: Vec<LineKey>,
     pub frames: Vec<i64>,
     pub plates: Vec<(String, Arc<Plates>)>,
+    /// The mattes' plates (Mask, Timing), by clip.
+    pub mattes: Vec<(String, Arc<Plates>)>,
+    pub params: Vec<ParamSetting>,
     pub inputs: Inputs,
 }
 
@@ -97,10 +103,21 @@ pub struct Job {
     pub view: String,
     /// Extra outputs: (view, path pattern).
     pub extra: Vec<(String, String)>,
+    /// Optional matte clips and their plates: (clip, path pattern).
+    pub mattes: Vec<(String, String)>,
     pub common: Common,
 }
 
 impl Job {
+    /// The job with its Mask and Timing inputs, where given.
+    pub fn with_mattes(mut self, mask: Option<String>, timing: Option<String>) -> Job {
+        self.mattes = [("Mask", mask), ("Timing", timing)]
+            .into_iter()
+            .filter_map(|(clip, p)| p.map(|p| (clip.to_owned(), p)))
+            .collect();
+        self
+    }
+
     /// Everything a run reads before it loads the bundle: the scene, the
     /// lines, the frames and every input's header.
     pub fn prepare(&self) -> Result<Prepared, HostError> {
@@ -123,11 +140,24 @@ impl Job {
             .map(|(clip, p)| (clip.clone(), Plates::new(p, c.colour())))
             .collect();
         let inputs = check_inputs(&plates, &frames)?;
+        let mattes: Vec<(String, Arc<Plates>)> = self
+            .mattes
+            .iter()
+            .map(|(clip, p)| (clip.clone(), Plates::new(p, c.colour())))
+            .collect();
+        check_mattes(&mattes, &frames)?;
+        let params = c
+            .param
+            .iter()
+            .map(|spec| ParamSetting::parse(spec))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Prepared {
             scene,
             lines,
             frames,
             plates,
+            mattes,
+            params,
             inputs,
         })
     }
@@ -136,7 +166,7 @@ impl Job {
         let job = self.prepare()?;
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;
-        self.set_up(&inst, &job.lines, &job.plates, job.inputs.size)?;
+        self.set_up(&inst, &job)?;
         self.render_frames(&inst, &job)
     }
 
@@ -163,14 +193,10 @@ impl Job {
         }
     }
 
-    /// The instance's params from the command line, its project and clips.
-    pub fn set_up(
-        &self,
-        inst: &Instance<'_>,
-        lines: &[LineKey],
-        plates: &[(String, Arc<Plates>)],
-        size: (usize, usize),
-    ) -> Result<(), HostError> {
+    /// The instance's params from the command line (`--param` last, so it
+    /// has the final word), its project and clips.
+    pub fn set_up(&self, inst: &Instance<'_>, job: &Prepared) -> Result<(), HostError> {
+        let (lines, size) = (&job.lines, job.inputs.size);
         let c = &self.common;
         if let Some(path) = &c.scene {
             let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.clone());
@@ -189,8 +215,11 @@ impl Job {
             inst.set_double("progress", &[t], None)?;
             inst.set_int("use_scene_progress", 0)?;
         }
+        for p in &job.params {
+            p.apply(inst)?;
+        }
         inst.set_project(size.0 as f64, size.1 as f64);
-        for (clip, p) in plates {
+        for (clip, p) in job.plates.iter().chain(&job.mattes) {
             inst.connect(clip, p.clone())?;
         }
         // Hosts ask for clip preferences once the clips are connected.
@@ -225,6 +254,7 @@ impl Job {
         let read_error = |e: HostError| {
             plates
                 .iter()
+                .chain(&job.mattes)
                 .find_map(|(_, p)| p.error.lock().unwrap_or_else(|p| p.into_inner()).take())
                 .unwrap_or(e)
         };
@@ -247,7 +277,7 @@ impl Job {
             }
             // The next frame's plates are read while this one renders.
             if let Some(&next) = frames.get(n + 1) {
-                for (_, p) in plates {
+                for (_, p) in plates.iter().chain(&job.mattes) {
                     p.read_ahead(next);
                 }
             }
@@ -322,6 +352,26 @@ pub fn read_scene(path: Option<&Path>) -> Result<Option<Scene>, HostError> {
     let bad = |e: &dyn std::fmt::Display| HostError::bad(format!("scene {}: {e}", path.display()));
     let text = std::fs::read_to_string(path).map_err(|e| bad(&e))?;
     Scene::parse(&text).map(Some).map_err(|e| bad(&e))
+}
+
+/// Checks that every matte can be read at every frame before anything is
+/// rendered. Mattes may have any size and region: each lines up with the
+/// sources by its own data window.
+pub fn check_mattes(mattes: &[(String, Arc<Plates>)], frames: &[i64]) -> Result<(), HostError> {
+    for (clip, p) in mattes {
+        for &f in frames {
+            let path = frame_path(&p.pattern, p.file_frame(f));
+            io::probe(&path).map_err(|e| {
+                HostError::bad(format!(
+                    "--{} {}: {}",
+                    clip.to_lowercase(),
+                    p.pattern,
+                    e.message
+                ))
+            })?;
+        }
+    }
+    Ok(())
 }
 
 /// What the input files' headers say, for every frame.

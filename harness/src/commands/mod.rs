@@ -7,6 +7,8 @@ pub mod job;
 pub mod line_key;
 pub mod openjd;
 pub mod overlay;
+pub mod param_value;
+pub mod params;
 pub mod plates;
 pub mod plugins;
 pub mod track;

@@ -28,6 +28,7 @@ pub fn overlay_job(
             sources: vec![("Source".to_owned(), input)],
             view: "warped".into(),
             extra: Vec::new(),
+            mattes: Vec::new(),
             common,
         }),
         _ => Err(HostError::bad(
@@ -62,7 +63,7 @@ impl Job {
         };
         let bundle = Bundle::load_with(bundle_path, options)?;
         let inst = bundle.instance(self.plugin, self.context)?;
-        self.set_up(&inst, &job.lines, &job.plates, job.inputs.size)?;
+        self.set_up(&inst, &job)?;
         self.draw_overlays(&inst, &job, show)
     }
 

@@ -256,18 +256,42 @@ impl Instance<'_> {
 
     /// Sets `name`'s option by its label (choice params).
     pub fn set_choice(&self, name: &str, option: &str) -> Result<(), HostError> {
+        let i = self.choice_index(name, option)?;
+        self.set_int(name, i as i32)
+    }
+
+    /// The index of choice param `name`'s option labelled `option` (or
+    /// whose label starts with that word).
+    pub fn choice_index(&self, name: &str, option: &str) -> Result<usize, HostError> {
         let p = self.param(name)?;
         let options = p.props.strs(kOfxParamPropChoiceOption);
-        let i = options
+        options
             .iter()
-            .position(|o| o == option || o.split(' ').next() == Some(option))
+            .position(|o| o == option)
+            .or_else(|| {
+                options
+                    .iter()
+                    .position(|o| o.split(' ').next() == Some(option))
+            })
             .ok_or_else(|| {
                 HostError::bad(format!(
                     "{name}: unknown option \"{option}\" (one of {})",
                     options.join(", ")
                 ))
-            })?;
-        self.set_int(name, i as i32)
+            })
+    }
+
+    /// Sets an integer-valued param (integer, boolean, choice): constant,
+    /// or keyed at `time` (keys hold until the next, as hosts step them).
+    pub fn set_int_at(&self, name: &str, value: i32, time: Option<f64>) -> Result<(), HostError> {
+        let p = self.param(name)?;
+        let mut v = ParamValue::default();
+        v.i[0] = value;
+        match time {
+            Some(t) => p.set_key(t, v),
+            None => p.set(v),
+        }
+        Ok(())
     }
 
     pub fn connect(&self, clip: &str, source: Arc<dyn FrameSource>) -> Result<(), HostError> {

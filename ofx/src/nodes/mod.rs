@@ -73,6 +73,15 @@ pub const VERSION: (u32, u32) = (1, 0);
 /// The pixel layouts every clip takes.
 const COMPONENTS: &[Components] = &[Components::Rgba, Components::Rgb, Components::Alpha];
 
+/// The layouts the mask and timing clips take: their alpha is what counts.
+const MATTE_COMPONENTS: &[Components] = &[Components::Alpha, Components::Rgba];
+
+/// The optional mask input of both nodes: where the effect applies.
+pub const MASK_CLIP: &str = "Mask";
+
+/// The Morph node's optional timing matte: when each point of A turns.
+pub const TIMING_CLIP: &str = "Timing";
+
 impl<N: Node> ImageEffect for N {
     const ID: &'static CStr = N::ID;
     const VERSION: (u32, u32) = VERSION;
@@ -107,8 +116,23 @@ impl<N: Node> ImageEffect for N {
             tiles: true,
             temporal_access: true,
             optional: false,
+            mask: false,
         };
         let mut clips: Vec<ClipSpec> = std::iter::once(a).chain(b).map(source).collect();
+        // Mattes: alpha is what is read (an RGB matte's mean where a host
+        // sends one anyway); the timing matte may be read anywhere on A.
+        let matte = |name, mask| ClipSpec {
+            name,
+            components: MATTE_COMPONENTS,
+            tiles: true,
+            temporal_access: false,
+            optional: true,
+            mask,
+        };
+        if N::KIND == NodeKind::Morph {
+            clips.push(matte(TIMING_CLIP, false));
+        }
+        clips.push(matte(MASK_CLIP, true));
         clips.push(ClipSpec {
             temporal_access: false,
             ..source("Output")

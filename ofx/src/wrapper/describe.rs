@@ -92,6 +92,9 @@ pub(super) fn describe_in_context<E: ImageEffect>(
                 spec.temporal_access as i32,
             );
             let _ = clip.set_int(kOfxImageClipPropOptional, 0, spec.optional as i32);
+            if spec.mask {
+                let _ = clip.set_int(kOfxImageClipPropIsMask, 0, 1);
+            }
         }
     }
     effect.param_set()?.define_all(&params)

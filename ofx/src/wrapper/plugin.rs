@@ -79,6 +79,8 @@ pub struct ClipSpec {
     pub tiles: bool,
     pub temporal_access: bool,
     pub optional: bool,
+    /// A mask input (`kOfxImageClipPropIsMask`): hosts show it as one.
+    pub mask: bool,
 }
 
 /// What describe-in-context defines: the clips (`Output` among them) and the

@@ -71,7 +71,7 @@ pub(super) fn methods(kind: NodeKind) -> &'static [Method] {
 pub fn views(kind: NodeKind) -> &'static [View] {
     match kind {
         NodeKind::Morph => View::ALL,
-        NodeKind::Warp => &[View::WarpedA, View::StmapA, View::Grid],
+        NodeKind::Warp => &[View::WarpedA, View::StmapA, View::Grid, View::Folds],
     }
 }
 

@@ -114,6 +114,8 @@ pub const TRANSITION_AFFECTS: Id<Choose<Affects>> = Id::new("transition_affects"
 pub const TRANSITION_SPREAD: Id<Double> = Id::new("transition_spread");
 pub const TRANSITION_ANGLE: Id<Double> = Id::new("transition_angle");
 pub const TRANSITION_CYCLES: Id<Double> = Id::new("transition_cycles");
+pub const MASK_INVERT: Id<Bool> = Id::new("mask_invert");
+pub const MIX: Id<Double> = Id::new("mix");
 
 /// The group holding line slot `k`'s params.
 pub fn slot_group(k: usize) -> String {

@@ -37,6 +37,14 @@ pub struct Settings {
     pub filter: Filter,
     pub edge: EdgeMode,
     pub view: View,
+    /// What a timing matte paces (the Transition group's Affects).
+    pub affects: Affects,
+    /// The share of the progress a timing matte's turns spread over.
+    pub spread: f64,
+    /// Share of the effect in the output, `[0, 1]`.
+    pub mix: f64,
+    /// The Mask input's alpha is read inverted.
+    pub mask_invert: bool,
     pub missing: Vec<String>,
     /// Why each param the host has could not be read.
     pub unreadable: Vec<String>,
@@ -97,6 +105,10 @@ impl Settings {
             filter: r.choice(&FILTER),
             edge: r.choice(&EDGE),
             view: r.pick(&VIEW, views(kind)),
+            affects: r.choice(&TRANSITION_AFFECTS),
+            spread: r.double(&TRANSITION_SPREAD),
+            mix: r.double(&MIX),
+            mask_invert: r.bool(&MASK_INVERT),
             missing: Vec::new(),
             unreadable: Vec::new(),
         };

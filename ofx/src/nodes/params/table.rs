@@ -177,8 +177,20 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(
             VIEW,
             "View",
-            "What the node outputs.",
+            "What the node outputs. ghost: where the warped sources still disagree (alpha the mean |A - B| over R, G, B; colour a heat ramp, black where they agree): double edges to fix. folds: where a warp folds the image over itself (alpha 1 there, the morph tinted magenta beneath).",
             choice_of(views(kind), |v| view_label(kind, v), views(kind)[0]),
+        ),
+        ParamSpec::new(
+            MASK_INVERT,
+            "Invert Mask",
+            "Use 1 - the Mask input's alpha: the effect applies where the mask is clear.",
+            Kind::Bool { default: false },
+        ),
+        ParamSpec::new(
+            MIX,
+            "Mix",
+            "How much of the effect reaches the output: 0 shows the source unchanged (Source A on the Morph node), 1 the full effect. Multiplies the Mask input's alpha where one is connected.",
+            Kind::Double { default: 1.0, min: 0.0, max: 1.0, display: (0.0, 1.0) },
         ),
     ]);
     t

@@ -4,7 +4,7 @@ use std::sync::{Arc, Mutex};
 
 use morphfx::features::{Feature, Side};
 use morphfx::geom::{PixelScale, Vec2};
-use morphfx::image::{Plane, RowsMut, Sample, Sampler, WarpMap};
+use morphfx::image::{Image, Plane, RowsMut, Sample, Sampler, WarpMap};
 use morphfx::morph::{dissolve, dissolve_weighted, show, Warped};
 use morphfx::transition::{Rates, Weights};
 use morphfx::views::{self, View};
@@ -44,6 +44,45 @@ impl Job<'_> {
             return self.draw_two_pass(pair, a, b, rows);
         }
         let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
+        match (self.view, b) {
+            (View::StmapA, _) => views::stmap(ma.expect("map A"), self.origin, self.size, rows),
+            (View::StmapB, _) => {
+                views::stmap(mb.or(ma).expect("map"), self.origin, self.size, rows)
+            }
+            (View::Transition, _) => match &self.rates {
+                Some(r) => views::transition_grey(r, ma.expect("map A"), rows),
+                None => views::transition_grey(&Rates::Uniform(self.t), ma.expect("map A"), rows),
+            },
+            (View::Grid, _) => views::grid(ma.expect("map A"), self.features, self.t, rows),
+            (View::Ghost, Some(b)) => {
+                let wa = Warped::Map(a, ma.expect("map A"));
+                let wb = Warped::Map(b, mb.expect("map B"));
+                views::ghost(
+                    self.in_output_state(&wa, Side::A),
+                    self.in_output_state(&wb, Side::B),
+                    rows,
+                )
+            }
+            (View::Folds, _) => {
+                let mut morph = Image::new(rows.bounds, 4);
+                self.picture(View::Morph, a, b, morph.view_mut().rows());
+                let maps: Vec<&WarpMap> = [ma, mb].into_iter().flatten().collect();
+                views::folds(&morph, &maps, rows)
+            }
+            (view, _) => self.picture(view, a, b, rows),
+        }
+    }
+
+    /// A picture view: the morph, or one warped source (A where there is
+    /// no B).
+    fn picture<S: Sample, D: Sample>(
+        &self,
+        view: View,
+        a: &Sampler<'_, S>,
+        b: Option<&Sampler<'_, S>>,
+        rows: RowsMut<'_, D>,
+    ) {
+        let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
         let wa = ma.map(|m| Warped::Map(a, m));
         let wb = b.zip(mb).map(|(b, m)| Warped::Map(b, m));
         macro_rules! picture {
@@ -51,7 +90,7 @@ impl Job<'_> {
                 self.in_output_state($w.as_ref().expect("a map for the side drawn"), $side)
             };
         }
-        match (self.view, b) {
+        match (view, b) {
             (View::Morph, Some(_)) => match &self.weights {
                 Some(w) => dissolve_weighted(
                     picture!(wa, Side::A),
@@ -62,18 +101,8 @@ impl Job<'_> {
                 ),
                 None => dissolve(picture!(wa, Side::A), picture!(wb, Side::B), self.t, rows),
             },
-            (View::Morph | View::WarpedA, _) => show(picture!(wa, Side::A), rows),
             (View::WarpedB, Some(_)) => show(picture!(wb, Side::B), rows),
-            (View::StmapA, _) => views::stmap(ma.expect("map A"), self.origin, self.size, rows),
-            (View::StmapB, _) => {
-                views::stmap(mb.or(ma).expect("map"), self.origin, self.size, rows)
-            }
-            (View::Transition, _) => match &self.rates {
-                Some(r) => views::transition_grey(r, ma.expect("map A"), rows),
-                None => views::transition_grey(&Rates::Uniform(self.t), ma.expect("map A"), rows),
-            },
-            (View::Grid, _) => views::grid(ma.expect("map A"), self.features, self.t, rows),
-            (View::WarpedB, None) => show(picture!(wa, Side::A), rows),
+            _ => show(picture!(wa, Side::A), rows),
         }
     }
 

@@ -13,8 +13,10 @@ use std::sync::Arc;
 
 use morphfx::features::Side;
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
-use morphfx::image::{EdgeMode, ImageView, Layout, Sampler, WarpMap};
+use morphfx::image::{EdgeMode, Filter, Image, ImageView, Layout, Sampler, WarpMap};
 use morphfx::make_warp::{self, Method};
+use morphfx::morph::mix::{mask_plane, mix, Mix};
+use morphfx::morph::Warped;
 use morphfx::transition;
 use morphfx::views::View;
 use morphfx::warp::auto::WorkImage;
@@ -23,7 +25,7 @@ use morphfx::warp::Warp;
 
 use super::params::Settings;
 use super::state::NodeState;
-use super::NodeKind;
+use super::{NodeKind, MASK_CLIP, TIMING_CLIP};
 use crate::cache::Key;
 use crate::wrapper::clips::{Depth, EffectHandle, HostImage, HostSample, ImageInfo};
 use crate::wrapper::plugin::RenderArgs;
@@ -54,6 +56,8 @@ macro_rules! with_depth {
         }
     };
 }
+
+mod mattes;
 
 /// The render action: gather, prepare, draw.
 pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) -> Outcome {
@@ -99,9 +103,11 @@ struct Request {
     work: Option<[WorkImage; 2]>,
 }
 
-/// The host's images one render holds: sources A and B, and the output.
+/// The host's images one render holds: sources A and B, the mask (picture
+/// views only), and the output.
 struct Lent {
     sources: [Option<HostImage>; 2],
+    mask: Option<HostImage>,
     out: HostImage,
 }
 
@@ -116,7 +122,7 @@ fn source(effect: &EffectHandle, name: &str, time: f64) -> Outcome<Option<HostIm
     clip.image(time)
 }
 
-fn scale_of(i: &ImageInfo) -> PixelScale {
+pub(super) fn scale_of(i: &ImageInfo) -> PixelScale {
     PixelScale::new(i.render_scale.0, i.render_scale.1, i.par)
 }
 
@@ -149,6 +155,17 @@ fn gather(
     let b = match b_name {
         Some(b) => source(effect, b, time + settings.offset_b as f64)?,
         None => None,
+    };
+    if kind == NodeKind::Morph {
+        if let Some(image) = source(effect, TIMING_CLIP, time)? {
+            let matte = mattes::timing_matte(&image)?;
+            inputs.warp.settings.transition = mattes::timed(matte, &settings);
+        }
+    }
+    let mask = if settings.view.is_picture() {
+        source(effect, MASK_CLIP, time)?
+    } else {
+        None
     };
     let out = effect
         .clip("Output")?
@@ -190,6 +207,7 @@ fn gather(
     };
     let lent = Lent {
         sources: [a, b],
+        mask,
         out,
     };
     Ok((request, lent))
@@ -297,7 +315,7 @@ fn prepare<'r>(kind: NodeKind, instance: &'r NodeState, request: &'r Request) ->
     let two_pass = mesh && inputs.warp.settings.mesh.pass == Pass::TwoPass;
     let picture = matches!(view, View::Morph | View::WarpedA | View::WarpedB);
     // A non-uniform colour transition weighs every pixel of the dissolve.
-    let weighted = view == View::Morph
+    let weighted = matches!(view, View::Morph | View::Folds)
         && kind == NodeKind::Morph
         && !inputs
             .warp
@@ -307,7 +325,13 @@ fn prepare<'r>(kind: NodeKind, instance: &'r NodeState, request: &'r Request) ->
             .is_uniform_at(inputs.t);
     // The two-pass mesh warp makes pixels, not maps; weights need maps.
     let by_map = !(two_pass && picture) || weighted;
-    let map = |side| map(instance, request, side);
+    // Folds are measured by central differences: one pixel more each side.
+    let w = request.window;
+    let window = match view {
+        View::Folds => RectI::new(w.x1 - 1, w.y1 - 1, w.x2 + 1, w.y2 + 1),
+        _ => w,
+    };
+    let map = |side| map(instance, request, side, window);
     // Weighted implies the Morph view of the Morph node: both maps drawn.
     let map_a = (needs_a(view) && by_map)
         .then(|| map(Side::A))
@@ -357,8 +381,13 @@ fn bad_input(e: morphfx::Error) -> Failure {
 /// The map of `side`'s warp over the render window, from the cache or made.
 /// Maps cover the render window, never more: a tile costs its own pixels,
 /// and an infinite region of definition costs nothing extra.
-fn map(instance: &NodeState, request: &Request, side: Side) -> Outcome<Arc<WarpMap>> {
-    let (inputs, window, scale) = (&request.inputs, request.window, request.out_scale);
+fn map(
+    instance: &NodeState,
+    request: &Request,
+    side: Side,
+    window: RectI,
+) -> Outcome<Arc<WarpMap>> {
+    let (inputs, scale) = (&request.inputs, request.out_scale);
     let key = Key::of(&(inputs, side, window, scale));
     instance.warps.get_or_compute(key, || {
         let w: Arc<dyn Warp> = if inputs.warp.method() == Method::ThinPlate {
@@ -379,7 +408,7 @@ fn weights(
     mb: &WarpMap,
 ) -> Outcome<Arc<transition::Weights>> {
     let inputs = &request.inputs;
-    let key = Key::of(&(inputs, "weights", request.window, request.out_scale));
+    let key = Key::of(&(inputs, "weights", ma.window, request.out_scale));
     instance.weights.get_or_compute(key, || {
         let colour = inputs
             .warp
@@ -407,12 +436,22 @@ fn premultiply(sources: &[Option<Source>; 2]) -> [bool; 2] {
 fn needs_a(view: View) -> bool {
     matches!(
         view,
-        View::Morph | View::WarpedA | View::StmapA | View::Grid | View::Transition
+        View::Morph
+            | View::WarpedA
+            | View::StmapA
+            | View::Grid
+            | View::Transition
+            | View::Ghost
+            | View::Folds
     )
 }
 
 fn needs_b(kind: NodeKind, view: View) -> bool {
-    kind == NodeKind::Morph && matches!(view, View::Morph | View::WarpedB | View::StmapB)
+    kind == NodeKind::Morph
+        && matches!(
+            view,
+            View::Morph | View::WarpedB | View::StmapB | View::Ghost | View::Folds
+        )
 }
 
 /// A view over `source`'s pixels, or over one transparent black pixel.
@@ -448,20 +487,54 @@ fn draw(kind: NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Ou
     };
     let ((a_scale, a_edge, a_pre), (b_scale, b_edge, b_pre)) =
         (sampler_parts(0, a), sampler_parts(1, b));
+    let mask = lent.mask.as_ref().map(mask_of).transpose()?;
+    let mixed = settings.view.is_picture() && (settings.mix < 1.0 || mask.is_some());
     with_depth!(lent.out.info().depth, D => {
         let rows = lent.out.rows_mut::<D>(request.window)?;
         with_depth!(request.depth, S => {
             let black = [S::default(); 4];
-            let a = Sampler::new(view_of::<S>(a, &black)?, a_scale, settings.filter, a_edge, a_pre);
-            if kind == NodeKind::Morph {
-                let b = Sampler::new(view_of::<S>(b, &black)?, b_scale, settings.filter, b_edge, b_pre);
-                job.draw(&a, Some(&b), rows);
-            } else {
-                job.draw(&a, None, rows);
+            let src = view_of::<S>(a, &black)?;
+            let a = Sampler::new(src, a_scale, settings.filter, a_edge, a_pre);
+            let b = Sampler::new(view_of::<S>(b, &black)?, b_scale, settings.filter, b_edge, b_pre);
+            let b = (kind == NodeKind::Morph).then_some(&b);
+            if !mixed {
+                job.draw(&a, b, rows);
+                return Ok(());
             }
+            // The effect in float, then mixed with the unwarped source A
+            // (transparent outside it) and stored once.
+            let mut effect = Image::new(rows.bounds, rows.channels);
+            job.draw(&a, b, effect.view_mut().rows());
+            let unwarped = Sampler::new(src, a_scale, Filter::Bilinear, EdgeMode::Black, a_pre);
+            let identity = WarpMap::identity(rows.bounds, request.out_scale);
+            let source = Warped::Map(&unwarped, &identity);
+            let plane = mask.as_ref().map(|m| m(rows.bounds, request.out_scale));
+            let how = Mix {
+                source: if job.premultiply[0] { Warped::Premultiplied(&source) } else { source },
+                mask: plane.as_ref(),
+                amount: settings.mix as f32,
+                invert: settings.mask_invert,
+            };
+            mix(&effect, &how, rows);
         })
     });
     Ok(())
+}
+
+/// The mask's alpha over a window at a scale, from the lent mask image.
+type MaskPlane<'a> = Box<dyn Fn(RectI, PixelScale) -> Image + 'a>;
+
+/// The lent mask as a maker of its alpha plane at its own depth: sampled at
+/// the output's pixel centres, transparent outside its region.
+fn mask_of(image: &HostImage) -> Outcome<MaskPlane<'_>> {
+    let scale = scale_of(image.info());
+    Ok(with_depth!(image.info().depth, M => {
+        let view = image.view::<M>()?;
+        Box::new(move |window: RectI, out_scale: PixelScale| {
+            let s = Sampler::new(view, scale, Filter::Bilinear, EdgeMode::Black, true);
+            mask_plane(Warped::Map(&s, &WarpMap::identity(window, out_scale)), window)
+        }) as MaskPlane<'_>
+    }))
 }
 
 #[cfg(test)]

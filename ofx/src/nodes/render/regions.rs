@@ -7,7 +7,7 @@ use morphfx::views::View;
 
 use super::inputs::{warp_inputs, WarpInputs};
 use crate::nodes::params::{Reader, Settings, OFFSET_A, OFFSET_B};
-use crate::nodes::{NodeKind, NodeState};
+use crate::nodes::{NodeKind, NodeState, MASK_CLIP, TIMING_CLIP};
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::plugin::{ClipPreferences, FramesNeeded, Identity, RenderArgs, Rois};
 use crate::wrapper::{Outcome, Reply};
@@ -109,7 +109,7 @@ pub fn regions_of_interest(
     time: f64,
     out: &mut Rois,
 ) -> Outcome<Reply> {
-    for (name, at) in source_times(node, time) {
+    for (name, at) in source_times(node, time).chain(matte_times(node, time)) {
         let clip = effect.clip(name)?;
         if !clip.is_connected() {
             continue;
@@ -121,13 +121,20 @@ pub fn regions_of_interest(
     Ok(Reply::Done)
 }
 
+/// The mattes (Mask; Timing on the Morph node), read at the output's time:
+/// the timing matte anywhere on A, so both whole.
+fn matte_times(node: &NodeState, time: f64) -> impl Iterator<Item = (&'static str, f64)> {
+    let timing = (node.kind == NodeKind::Morph).then_some((TIMING_CLIP, time));
+    timing.into_iter().chain([(MASK_CLIP, time)])
+}
+
 pub fn frames_needed(
     node: &NodeState,
     _: &EffectHandle,
     time: f64,
     out: &mut FramesNeeded,
 ) -> Outcome<Reply> {
-    for (name, at) in source_times(node, time) {
+    for (name, at) in source_times(node, time).chain(matte_times(node, time)) {
         out.set(name, (at, at));
     }
     Ok(Reply::Done)
@@ -144,7 +151,16 @@ pub fn is_identity(
     let time = args.time;
     let settings = Settings::read(node.params(), time, node.kind);
     let inputs = warp_inputs(node, &settings, time)?;
-    let Some(side) = identity_side(node.kind, settings.view, &inputs) else {
+    // A mask or a mix below 1 dials a picture back toward source A: the
+    // output is A where the effect is, or where none of it reaches.
+    let picture = settings.view.is_picture();
+    let masked = picture && (settings.mix < 1.0 || effect.clip(MASK_CLIP)?.is_connected());
+    let side = if picture && settings.mix <= 0.0 {
+        Some(Side::A)
+    } else {
+        identity_side(node.kind, settings.view, &inputs).filter(|s| !masked || *s == Side::A)
+    };
+    let Some(side) = side else {
         return Ok(None);
     };
     let (a, b) = node.kind.source_clips(node.context);
