@@ -1,0 +1,323 @@
+//! `morphfx morph|warp --mask --timing --param` and `morphfx params` end to
+//! end: the mask's closed form through EXR and PNG, the timing matte, and
+//! bad input refused with exit 2 before anything is written.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+
+use morphfx::geom::RectI;
+use morphfx::image::Image;
+use morphfx_harness::io::{self, Colour, ExrPrecision, OutputFormat, Plate};
+
+const W: usize = 80;
+const H: usize = 60;
+const LINE: &str = "1=10,10,60,14,18,6,66,22";
+/// A line that stays put: the warps are the identity.
+const STILL_LINE: &str = "1=10,10,60,10,10,10,60,10";
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn morphfx(args: &[&str]) -> (i32, String) {
+    let out = common::run_morphfx(args);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn ok(args: &[&str]) {
+    let (code, err) = morphfx(args);
+    assert_eq!(code, 0, "morphfx {args:?}: {err}");
+}
+
+/// An opaque textured plate in `[0.1, 0.9]`, written as a float EXR.
+fn plate(dir: &Path, name: &str, seed: f32) -> PathBuf {
+    let img = Image::from_fn(RectI::from_size(W, H), 4, |i, j, c| {
+        if c == 3 {
+            1.0
+        } else {
+            0.5 + 0.4 * (i as f32 * 0.29 + j as f32 * 0.13 + seed + c as f32).sin()
+        }
+    });
+    let p = dir.join(name);
+    io::write(&p, &Plate::new(img, (W, H)), ExrPrecision::Float).unwrap();
+    p
+}
+
+/// A mask of another size than the plates, 8-bit PNG (raw code values):
+/// alpha a ramp across x.
+fn mask_png(dir: &Path) -> (PathBuf, Image) {
+    let (w, h) = (50, 40);
+    let img = Image::from_fn(RectI::from_size(w, h), 4, |i, _, c| {
+        if c == 3 {
+            (i * 5) as f32 / 255.0
+        } else {
+            1.0
+        }
+    });
+    let p = dir.join("mask.png");
+    let format = OutputFormat {
+        colour: Colour::Raw,
+        ..OutputFormat::new(ExrPrecision::Float)
+    };
+    io::write_as(&p, &Plate::new(img.clone(), (w, h)), format).unwrap();
+    (p, img)
+}
+
+fn read(p: &Path, colour: Colour) -> Image {
+    io::read_as(p, colour).unwrap().image
+}
+
+#[test]
+fn a_mask_and_mix_through_exr_and_png_match_the_closed_form() {
+    let d = common::scratch("mask-cli");
+    let a = plate(&d, "a.exr", 0.0);
+    let (mask, m) = mask_png(&d);
+    let full = d.join("full.exr");
+    ok(&[
+        "warp",
+        "--line",
+        LINE,
+        "--input",
+        s(&a),
+        "--t",
+        "1",
+        "-o",
+        s(&full),
+    ]);
+    let effect = read(&full, Colour::Raw);
+    let src = read(&a, Colour::Raw);
+    // The mask's pixel rows are numbered from its own top: its display
+    // window is 40 high, bottom-aligned with the plates' origin.
+    let alpha = |i: i32, j: i32| {
+        if (i as usize) < m.width() && (j as usize) < m.height() {
+            m.pixel(i, j)[3]
+        } else {
+            0.0
+        }
+    };
+    for (out, colour, tolerance) in [
+        ("masked.exr", Colour::Raw, 1e-5),
+        ("masked.png", Colour::Raw, 1.0 / 255.0 + 1e-4),
+    ] {
+        let out = d.join(out);
+        ok(&[
+            "warp",
+            "--line",
+            LINE,
+            "--input",
+            s(&a),
+            "--t",
+            "1",
+            "--mask",
+            s(&mask),
+            "--param",
+            "mix=0.5",
+            "--raw",
+            "-o",
+            s(&out),
+        ]);
+        let got = read(&out, colour);
+        for j in 0..H as i32 {
+            for i in 0..W as i32 {
+                for c in 0..3 {
+                    let (e, sv) = (effect.pixel(i, j)[c], src.pixel(i, j)[c]);
+                    let want = sv + (e - sv) * 0.5 * alpha(i, j);
+                    let g = got.pixel(i, j)[c];
+                    assert!(
+                        (g - want).abs() <= tolerance,
+                        "{} ({i}, {j}) {c}: {g} vs {want}",
+                        out.display()
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_timing_matte_on_the_command_line_paces_the_dissolve() {
+    let d = common::scratch("timing-cli");
+    let flat = |name: &str, v: f32| {
+        let img = Image::from_fn(
+            RectI::from_size(W, H),
+            4,
+            |_, _, c| {
+                if c == 3 {
+                    1.0
+                } else {
+                    v
+                }
+            },
+        );
+        let p = d.join(name);
+        io::write(&p, &Plate::new(img, (W, H)), ExrPrecision::Float).unwrap();
+        p
+    };
+    let (a, b) = (flat("a.exr", 0.2), flat("b.exr", 0.8));
+    let matte = Image::from_fn(RectI::from_size(W, H), 4, |i, _, _| {
+        i as f32 / (W - 1) as f32
+    });
+    let mp = d.join("timing.exr");
+    io::write(&mp, &Plate::new(matte.clone(), (W, H)), ExrPrecision::Float).unwrap();
+    let out = d.join("out.exr");
+    ok(&[
+        "morph",
+        "--line",
+        STILL_LINE,
+        "--a",
+        s(&a),
+        "--b",
+        s(&b),
+        "--t",
+        "0.5",
+        "--timing",
+        s(&mp),
+        "--param",
+        "transition_spread=0.5",
+        "-o",
+        s(&out),
+    ]);
+    let got = read(&out, Colour::Raw);
+    for i in 0..W as i32 {
+        let g = matte.pixel(i, 3)[3] as f64;
+        let rate = ((0.5 - 0.5 * g) / 0.5).clamp(0.0, 1.0);
+        let want = (0.2 + (0.8 - 0.2) * rate) as f32;
+        assert!((got.pixel(i, 3)[0] - want).abs() < 1e-5, "column {i}");
+    }
+}
+
+#[test]
+fn unreadable_or_missing_mattes_and_bad_params_exit_2_writing_nothing() {
+    let d = common::scratch("mattes-bad");
+    let a = plate(&d, "a.exr", 0.0);
+    let seq_a = d.join("a.####.exr");
+    for f in 1..=3 {
+        std::fs::copy(&a, d.join(format!("a.{f:04}.exr"))).unwrap();
+    }
+    // Frames 1 and 2 of the mask exist, 3 does not.
+    let (mask, _) = mask_png(&d);
+    std::fs::copy(&mask, d.join("m.0001.png")).unwrap();
+    std::fs::copy(&mask, d.join("m.0002.png")).unwrap();
+    let garbage = d.join("garbage.exr");
+    std::fs::write(&garbage, b"not an exr").unwrap();
+    let out = d.join("out.####.exr");
+    let warp = |extra: &[&str]| {
+        let mut args = vec![
+            "warp",
+            "--line",
+            LINE,
+            "--input",
+            s(&seq_a),
+            "--frames",
+            "1-3",
+            "-o",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        morphfx(&args)
+    };
+    let m_seq = d.join("m.####.png");
+    for (extra, says) in [
+        (vec!["--mask", s(&m_seq)], "m.0003.png"),
+        (vec!["--mask", s(&garbage)], "garbage.exr"),
+        (vec!["--param", "mix=2"], "out of range"),
+        (vec!["--param", "no_such=1"], "no param no_such"),
+        (vec!["--param", "mask_invert=maybe"], "true or false"),
+        (vec!["--param", "filter=sharp"], "unknown option"),
+        (vec!["--param", "tolerance@2=0.1"], "cannot be animated"),
+        (vec!["--param", "view=ghost"], "--view"),
+    ] {
+        let (code, err) = warp(&extra);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains(says), "{extra:?}: {err}");
+        let written: Vec<_> = std::fs::read_dir(&d)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().starts_with("out"))
+            .collect();
+        assert!(written.is_empty(), "{extra:?} wrote {written:?}");
+    }
+    let (code, err) = morphfx(&[
+        "morph",
+        "--line",
+        LINE,
+        "--a",
+        s(&a),
+        "--b",
+        s(&a),
+        "--timing",
+        s(&garbage),
+        "-o",
+        s(&d.join("x.exr")),
+    ]);
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn keyed_params_interpolate_and_params_lists_every_id() {
+    let d = common::scratch("param-keys");
+    let a = plate(&d, "a.exr", 0.0);
+    let seq = d.join("a.####.exr");
+    for f in 1..=3 {
+        std::fs::copy(&a, d.join(format!("a.{f:04}.exr"))).unwrap();
+    }
+    let out = d.join("o.####.exr");
+    ok(&[
+        "warp",
+        "--line",
+        LINE,
+        "--input",
+        s(&seq),
+        "--frames",
+        "1-3",
+        "--t",
+        "1",
+        "--param",
+        "mix@1=0",
+        "--param",
+        "mix@3=1",
+        "-o",
+        s(&out),
+    ]);
+    let full = d.join("full.exr");
+    ok(&[
+        "warp",
+        "--line",
+        LINE,
+        "--input",
+        s(&a),
+        "--t",
+        "1",
+        "-o",
+        s(&full),
+    ]);
+    let (effect, src) = (read(&full, Colour::Raw), read(&a, Colour::Raw));
+    for (f, mix) in [(1, 0.0f32), (2, 0.5), (3, 1.0)] {
+        let got = read(&d.join(format!("o.{f:04}.exr")), Colour::Raw);
+        for (k, g) in got.data.iter().enumerate() {
+            let want = src.data[k] + (effect.data[k] - src.data[k]) * mix;
+            assert!(
+                (g - want).abs() < 1e-5,
+                "frame {f} sample {k}: {g} vs {want}"
+            );
+        }
+    }
+    let listed = common::run_morphfx(&["params", "--node", "morph"]);
+    let text = String::from_utf8_lossy(&listed.stdout);
+    for id in [
+        "mix ",
+        "mask_invert ",
+        "view ",
+        "transition_spread ",
+        "line64_b_end ",
+    ] {
+        assert!(text.contains(id), "{id} missing from:\n{text}");
+    }
+    assert!(text.contains("ghost") && text.contains("folds"));
+    let (code, _) = morphfx(&["params", "--node", "blur"]);
+    assert_eq!(code, 2);
+}
