@@ -69,10 +69,13 @@ std::vector<std::string> mandatedClips(const std::string &context) {
   return {"Output"};
 }
 
+/// The source clips, inputs first; the optional mattes are not sources.
 std::vector<std::string> inputClips(IE::Instance &fx) {
   std::vector<std::string> names;
-  for (auto *d : fx.getDescriptor().getClipsByOrder())
-    if (d->getName() != "Output") names.push_back(d->getName());
+  for (auto *d : fx.getDescriptor().getClipsByOrder()) {
+    const std::string &n = d->getName();
+    if (n != "Output" && n != "Mask" && n != "Timing") names.push_back(n);
+  }
   return names;
 }
 
@@ -197,6 +200,74 @@ Render render(Effect &fx, OfxPointD scale, const Where &w) {
   for (double &m : out.mean) m /= double(n);
   out.ok = true;
   return out;
+}
+
+/// The output pixels of the last render, as floats (RGBA, row by row).
+std::vector<float> outputPixels(Effect &fx) {
+  std::vector<float> v;
+  auto *clip = dynamic_cast<Clip *>(fx.getClip("Output"));
+  if (!clip || !clip->output) return v;
+  const OfxRectI &b = fx.renderWindow;
+  for (int y = b.y1; y < b.y2; ++y)
+    for (int x = b.x1; x < b.x2; ++x)
+      for (int c = 0; c < 4; ++c) v.push_back(clip->output->at(x, y, c));
+  return v;
+}
+
+/// The Mask (and on Morph the Timing) clip connected through the library:
+/// at render scale 1 the masked picture is `src + (effect - src) * mix * m`
+/// pixel for pixel, src Source A and m the mask's alpha; the timing matte
+/// changes the picture; at scale 0.5 both render, their means close to
+/// scale 1's (render's own checks).
+void checkMattes(Effect &fx, const Where &w) {
+  const std::vector<std::string> inputs = inputClips(fx);
+  const OfxPointD one = {1, 1};
+  const Render plain = render(fx, one, w.with("no mattes"));
+  const std::vector<float> effect = outputPixels(fx);
+  if (!plain.ok) return;
+  auto *mix = dynamic_cast<OFX::Host::Param::DoubleInstance *>(fx.getParam("mix"));
+  if (!mix) return fail(w.text + ": no double param mix");
+  mix->set(0.5);
+  fx.maskConnected = true;
+  const Where wm = w.with("Mask, mix 0.5");
+  const Render masked = render(fx, one, wm.with("scale 1"));
+  const std::vector<float> got = outputPixels(fx);
+  if (masked.ok && got.size() == effect.size()) {
+    const OfxRectI &b = fx.renderWindow;
+    size_t k = 0;
+    int bad = 0;
+    for (int y = b.y1; y < b.y2; ++y)
+      for (int x = b.x1; x < b.x2; ++x)
+        for (int c = 0; c < 4; ++c, ++k) {
+          const double px = x + 0.5, py = y + 0.5;
+          const float src = sourceValue(inputs[0], px, py, c);
+          const float m = sourceValue("Mask", px, py, 3);
+          const float want = src + (effect[k] - src) * 0.5f * m;
+          if (std::fabs(got[k] - want) > 1e-4f && bad++ == 0) {
+            std::ostringstream msg;
+            msg << wm.text << ": pixel (" << x << ", " << y << ") channel " << c << " is "
+                << got[k] << ", not " << want << " (effect " << effect[k] << ", source "
+                << src << ", mask " << m << ")";
+            fail(msg.str());
+          }
+        }
+  }
+  render(fx, {0.5, 0.5}, wm.with("scale 0.5"));
+  mix->set(1.0);
+  fx.maskConnected = false;
+  if (fx.getClip("Timing")) {
+    fx.timingConnected = true;
+    const Where wt = w.with("Timing");
+    const Render timed = render(fx, one, wt.with("scale 1"));
+    const Render half = render(fx, {0.5, 0.5}, wt.with("scale 0.5"));
+    bool differs = false;
+    for (int c = 0; c < 3; ++c) differs |= std::fabs(timed.mean[c] - plain.mean[c]) > 1e-3;
+    if (timed.ok && !differs) fail(wt.text + ": the timing matte changed nothing");
+    for (int c = 0; c < 4; ++c)
+      if (timed.ok && half.ok && std::fabs(timed.mean[c] - half.mean[c]) > 0.03)
+        fail(wt.text + ": channel means differ between scale 1 and 0.5");
+    fx.timingConnected = false;
+  }
 }
 
 /// At the ends of the morph the node passes a source through, and says so.
@@ -512,6 +583,7 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
     checkOverlay(*fx, w.with("overlay"));
     checkOverlayGl(*fx, w.with("overlay in OpenGL"));
     if (inputClips(*fx).size() == 2) checkTrack(*fx, w.with("track"));
+    checkMattes(*fx, w.with("mattes"));
   }
 
   auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("method"));

@@ -326,6 +326,9 @@ static void store(Pixels &p, size_t i, float v) {
 }
 
 float sourceValue(const std::string &clip, double x, double y, int channel) {
+  // The mattes: the mask's alpha a ramp across, the timing matte's up.
+  if (clip == "Mask") return channel == 3 ? float(x / kProjectWidth) : 1.0f;
+  if (clip == "Timing") return channel == 3 ? float(y / kProjectHeight) : 0.0f;
   if (channel == 3) return 1.0f;
   const bool isA = clip == "Source" || clip == "SourceA" || clip == "SourceFrom";
   if (isA) {
@@ -377,7 +380,11 @@ const std::string &Clip::getFieldOrder() const {
   static const std::string none = kOfxImageFieldNone;
   return none;
 }
-bool Clip::getConnected() const { return isOutput() || effect_->connected; }
+bool Clip::getConnected() const {
+  if (getName() == "Mask") return effect_->connected && effect_->maskConnected;
+  if (getName() == "Timing") return effect_->connected && effect_->timingConnected;
+  return isOutput() || effect_->connected;
+}
 double Clip::getUnmappedFrameRate() const { return 24.0; }
 void Clip::getUnmappedFrameRange(double &s, double &e) const { s = 0, e = 10; }
 bool Clip::getContinuousSamples() const { return false; }

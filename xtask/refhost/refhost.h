@@ -78,6 +78,9 @@ class Effect : public OFX::Host::ImageEffect::Instance {
   bool rendering = false;
   /// Whether the input clips are connected (a node just made has none).
   bool connected = true;
+  /// Whether the optional Mask and Timing clips are connected too.
+  bool maskConnected = false;
+  bool timingConnected = false;
   /// Whether the input clips' colour is straight (not premultiplied).
   bool straight = false;
   /// The persistent message the plugin last set (empty once cleared).
