@@ -290,6 +290,24 @@ fn demo_renders_every_built_method_with_exact_end_frames() {
             .fold(0f32, f32::max);
         assert!(moved > 0.1, "{method}: the middle frame is plate A");
     }
+    // The features line the faces up: the middle frame's ghost is dark.
+    let ghost = read(d.join("ghost.0006.exr"));
+    let alpha: Vec<f32> = ghost.data.chunks(4).map(|p| p[3]).collect();
+    let mean = alpha.iter().sum::<f32>() / alpha.len() as f32;
+    let bright = alpha.iter().filter(|a| **a > 0.1).count() as f32 / alpha.len() as f32;
+    assert!(
+        mean < 0.05 && bright < 0.08,
+        "ghost mean {mean}, {bright} above 0.1"
+    );
+    // The last line names the contact sheet: every frame, half size, 4 across.
+    let out = common::run_morphfx(&["demo", "-o", d.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let last = stdout.lines().last().unwrap_or_default();
+    let sheet = last
+        .strip_prefix("contact sheet: ")
+        .expect("the sheet, last");
+    let sheet = io::read(Path::new(sheet)).unwrap();
+    assert_eq!(sheet.size, (4 * 160, 3 * 120));
 }
 
 /// A plate whose data window is `bounds` (canonical, may reach outside the

@@ -73,6 +73,7 @@ pub fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
         vec![
             ("morph".into(), s(dir.join("preview/morph.####.png"))),
             ("stmap-a".into(), s(dir.join("stmap_a.####.exr"))),
+            ("ghost".into(), s(dir.join("ghost.####.exr"))),
         ],
     )?;
 
@@ -100,8 +101,56 @@ pub fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
             Vec::new(),
         )?;
     }
-    demo_report(bundle_path, dir);
+    let ghost = ghost_figures(dir)?;
+    let sheet = contact_sheet(dir)?;
+    demo_report(bundle_path, dir, ghost, &sheet);
     Ok(())
+}
+
+/// The frames of the demo's morph.
+const FRAMES: std::ops::RangeInclusive<i64> = 1..=12;
+
+/// The middle frame's ghost (the mean |warped A − warped B| per pixel):
+/// its mean over the frame, and the share of pixels above 0.1, where
+/// doubled edges show.
+fn ghost_figures(dir: &Path) -> Result<(f64, f64), HostError> {
+    let ghost = io::read(&dir.join("ghost.0006.exr"))?.image;
+    let alpha: Vec<f32> = ghost.data.chunks(4).map(|p| p[3]).collect();
+    let n = alpha.len().max(1) as f64;
+    let mean = alpha.iter().map(|a| *a as f64).sum::<f64>() / n;
+    let bright = alpha.iter().filter(|a| **a > 0.1).count() as f64 / n;
+    Ok((mean, bright))
+}
+
+/// Every frame of the morph at half size in a grid of four columns, as
+/// one sRGB PNG: the whole demo at a glance.
+fn contact_sheet(dir: &Path) -> Result<PathBuf, HostError> {
+    const COLUMNS: usize = 4;
+    let frames: Vec<Image> = FRAMES
+        .map(|f| io::read(&dir.join(format!("morph.{f:04}.exr"))).map(|p| p.image))
+        .collect::<Result<_, _>>()?;
+    let (w, h) = (frames[0].width() / 2, frames[0].height() / 2);
+    let rows = frames.len().div_ceil(COLUMNS);
+    let (sw, sh) = (COLUMNS * w, rows * h);
+    // Rows of the sheet count from the bottom: the first frame goes top left.
+    let sheet = Image::from_fn(RectI::from_size(sw, sh), 4, |i, j, c| {
+        let (col, row) = (i as usize / w, (sh - 1 - j as usize) / h);
+        let Some(frame) = frames.get(row * COLUMNS + col) else {
+            return if c == 3 { 1.0 } else { 0.0 };
+        };
+        let (x, y) = (
+            2 * (i as usize % w),
+            2 * (h - 1 - (sh - 1 - j as usize) % h),
+        );
+        let mut sum = 0.0;
+        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            sum += frame.pixel((x + dx) as i32, (y + dy) as i32)[c];
+        }
+        sum / 4.0
+    });
+    let path = dir.join("contact-sheet.png");
+    io::write(&path, &Plate::new(sheet, (sw, sh)), ExrPrecision::Float)?;
+    Ok(path)
 }
 
 /// The demo plates: a round face (A) and a square one (B) on a gradient.
@@ -128,8 +177,10 @@ pub fn demo_face(i: i32, j: i32, c: usize, square: bool, (w, h): (usize, usize))
         0.12 + 0.2 * (i as f32 / w as f32),
         1.0,
     ];
+    // Close tones, so the ghost view shows where shapes disagree rather
+    // than the change of colour.
     let skin = if square {
-        [0.3, 0.55, 0.9, 1.0]
+        [0.85, 0.62, 0.42, 1.0]
     } else {
         [0.95, 0.6, 0.3, 1.0]
     };
@@ -142,19 +193,32 @@ pub fn demo_face(i: i32, j: i32, c: usize, square: bool, (w, h): (usize, usize))
     }
 }
 
-/// The demo scene: eyes, mouth and the face's outline, keyed over frames 1-12.
+/// Points of the outline, one per `OUTLINE_SEGMENTS`-th turn: A's disc and
+/// B's square face met by the same ray from the centre.
+const OUTLINE_SEGMENTS: usize = 32;
+
+/// The demo scene: eyes and mouth as lines across them, and the face's
+/// outline as a closed polyline from the disc to the square, ray by ray, so
+/// every edge of A lands on B's (its ghost view stays dark).
 pub fn demo_scene((cx, cy): (f64, f64)) -> serde_json::Value {
+    let ray = |k: usize| {
+        let a = std::f64::consts::TAU * k as f64 / OUTLINE_SEGMENTS as f64;
+        let (c, s) = (a.cos(), a.sin());
+        // The square face: |x| < 85, |y| < 85 / 1.1 (see `demo_face`).
+        let r = (85.0 / c.abs().max(1e-9)).min(85.0 / 1.1 / s.abs().max(1e-9));
+        ([cx + 90.0 * c, cy + 90.0 * s], [cx + r * c, cy + r * s])
+    };
+    let (outline_a, outline_b): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
+        (0..=OUTLINE_SEGMENTS).map(ray).unzip();
+    let across = |(x, y): (f64, f64), half: f64| [[cx + x - half, cy + y], [cx + x + half, cy + y]];
     serde_json::json!({
         "format": "morphfx-scene", "version": 1, "method": "field",
         "field": { "a": 0.5, "b": 1.5, "p": 0.5, "interpolation": "endpoints" },
         "features": [
-            { "name": "left eye", "type": "point", "a": [[cx - 30.0, cy + 25.0]], "b": [[cx - 35.0, cy + 35.0]] },
-            { "name": "right eye", "type": "point", "a": [[cx + 30.0, cy + 25.0]], "b": [[cx + 35.0, cy + 35.0]] },
-            { "name": "mouth", "type": "line", "a": [[cx - 35.0, cy - 35.0], [cx + 35.0, cy - 35.0]], "b": [[cx - 45.0, cy - 40.0], [cx + 45.0, cy - 40.0]] },
-            { "name": "top", "type": "line", "a": [[cx - 60.0, cy + 66.0], [cx + 60.0, cy + 66.0]], "b": [[cx - 80.0, cy + 77.0], [cx + 80.0, cy + 77.0]] },
-            { "name": "bottom", "type": "line", "a": [[cx + 60.0, cy - 66.0], [cx - 60.0, cy - 66.0]], "b": [[cx + 80.0, cy - 77.0], [cx - 80.0, cy - 77.0]] },
-            { "name": "left", "type": "line", "a": [[cx - 90.0, cy - 30.0], [cx - 90.0, cy + 30.0]], "b": [[cx - 85.0, cy - 40.0], [cx - 85.0, cy + 40.0]] },
-            { "name": "right", "type": "line", "a": [[cx + 90.0, cy + 30.0], [cx + 90.0, cy - 30.0]], "b": [[cx + 85.0, cy + 40.0], [cx + 85.0, cy - 40.0]] }
+            { "name": "left eye", "type": "line", "a": across((-30.0, 25.0), 9.0), "b": across((-35.0, 35.0), 9.0) },
+            { "name": "right eye", "type": "line", "a": across((30.0, 25.0), 9.0), "b": across((35.0, 35.0), 9.0) },
+            { "name": "mouth", "type": "line", "a": across((0.0, -35.0), 35.0), "b": across((0.0, -40.0), 45.0) },
+            { "name": "outline", "type": "polyline", "a": outline_a, "b": outline_b }
         ],
         "progress": [[1, 0.0], [12, 1.0]]
     })
@@ -181,8 +245,9 @@ pub fn demo_mesh((w, h): (usize, usize), (cx, cy): (f64, f64)) -> (Vec<[f64; 2]>
     (nodes_a, nodes_b)
 }
 
-/// Says where the demo wrote what.
-pub fn demo_report(bundle_path: &Path, dir: &Path) {
+/// Says where the demo wrote what, how well its features line up, and,
+/// last, the one picture to look at.
+pub fn demo_report(bundle_path: &Path, dir: &Path, (ghost, bright): (f64, f64), sheet: &Path) {
     let plates = dir.join("plates");
     let scene_path = dir.join("demo.morph.json");
     println!(
@@ -209,4 +274,10 @@ pub fn demo_report(bundle_path: &Path, dir: &Path) {
         dir.join("triangles/morph.####.png").display(),
         dir.join("auto/morph.####.png").display()
     );
+    println!(
+        "  ghost:    {} (frame 6: mean {ghost:.3}; {:.1}% of pixels above 0.1, where edges double)",
+        dir.join("ghost.####.exr").display(),
+        100.0 * bright
+    );
+    println!("contact sheet: {}", sheet.display());
 }
