@@ -19,7 +19,8 @@ const LAYERS: &[(&str, u32)] = &[
     ("snake", 3),
     ("make_warp", 4),
     ("morph", 4),
-    ("views", 4),
+    // The ghost view compares the dissolve's warped sources.
+    ("views", 5),
     ("scene", 5),
     // Helpers for tests and benches: nothing else may use them.
     ("testing", 6),

@@ -1,7 +1,7 @@
 //! A timing matte: an image whose alpha says when each point of A has its
 //! turn. It plays the part of a procedural pattern's `g(p)` (Lee et al.
 //! §4.2), painted or rotoscoped by the user instead of computed, and is
-//! paced the same way: `T(p, t) = clamp((t − spread · g(p)) / (1 − spread), 0, 1)`.
+//! paced the same way ([`super::pace::paced`]).
 
 use std::fmt;
 use std::hash::Hasher;
@@ -101,19 +101,6 @@ impl fmt::Debug for Matte {
     }
 }
 
-/// The rate of a point whose turn is `g` at progress `t`, its change spread
-/// over `1 − spread` of the progress: exactly 0 at `t = 0` and 1 at `t = 1`.
-pub fn paced(g: f64, t: f64, spread: f64) -> f64 {
-    if t <= 0.0 {
-        return 0.0;
-    }
-    if t >= 1.0 {
-        return 1.0;
-    }
-    let s = spread.clamp(0.0, super::procedural::MAX_SPREAD);
-    ((t - s * g) / (1.0 - s)).clamp(0.0, 1.0)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -154,15 +141,5 @@ mod tests {
         assert_eq!(format!("{m:?}"), format!("{same:?}"));
         assert_ne!(format!("{m:?}"), format!("{other:?}"));
         assert!(Matte::new(w, PixelScale::UNIT, vec![0.0]).is_err());
-    }
-
-    #[test]
-    fn pacing_is_the_procedural_closed_form() {
-        assert_eq!(paced(0.7, 0.0, 0.5), 0.0);
-        assert_eq!(paced(0.7, 1.0, 0.5), 1.0);
-        // s = 0.5, g = 0.2, t = 0.4: (0.4 - 0.1) / 0.5 = 0.6.
-        assert!((paced(0.2, 0.4, 0.5) - 0.6).abs() < 1e-12);
-        assert_eq!(paced(1.0, 0.4, 0.5), 0.0);
-        assert_eq!(paced(0.3, 0.4, 0.0), 0.4);
     }
 }

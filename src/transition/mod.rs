@@ -10,6 +10,7 @@
 
 pub mod curve;
 pub mod matte;
+pub mod pace;
 pub mod procedural;
 
 use std::sync::Arc;
@@ -156,7 +157,7 @@ impl Rates {
                 frame,
                 t,
             } => return procedural.rate(p, *frame, *t),
-            Rates::Matte { matte, spread, t } => return matte::paced(matte.order(p), *t, *spread),
+            Rates::Matte { matte, spread, t } => return pace::paced(matte.order(p), *t, *spread),
             Rates::Surface { t, delta } => t + delta.eval(p),
             Rates::Plate { t, delta } => t + delta.displacement(p).x,
         };

@@ -83,8 +83,7 @@ pub struct Procedural {
     pub spread: f64,
 }
 
-/// The largest `spread`: at 1 the first point would finish before the last began.
-pub const MAX_SPREAD: f64 = 0.99;
+pub use super::pace::MAX_SPREAD;
 
 impl Procedural {
     /// `g(p)`: when the point at `p` (canonical, on A) has its turn.
@@ -134,6 +133,6 @@ impl Procedural {
         if t <= 0.0 || t >= 1.0 {
             return t.clamp(0.0, 1.0);
         }
-        super::matte::paced(self.order(p, frame), t, self.spread)
+        super::pace::paced(self.order(p, frame), t, self.spread)
     }
 }
