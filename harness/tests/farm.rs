@@ -87,6 +87,8 @@ fn a_job_bundle_holds_the_command_line_as_the_template_takes_it() {
         "1-9:2",
         "--t",
         "0.3",
+        "--mask",
+        "shot/mask.exr",
         "-o",
         &s(&d.join("out.####.exr")),
     ]);
@@ -107,7 +109,10 @@ fn a_job_bundle_holds_the_command_line_as_the_template_takes_it() {
     assert_eq!(values["Frames"], "1-9:2");
     assert_eq!(values["ChunkSize"], 4);
     assert_eq!(values["ChunkTargetRuntime"], 0);
-    assert_eq!(values["ExtraArgs"], "--t 0.3");
+    // A file among them is made absolute too: workers start elsewhere.
+    let mask = std::path::absolute("shot/mask.exr").unwrap();
+    let extra = format!("--t 0.3 --mask {}", mask.display());
+    assert_eq!(values["ExtraArgs"], extra.as_str());
     assert_eq!(values["Morphfx"], "morphfx");
     assert_eq!(values["Input"], s(&d.join("a.exr")));
     assert_eq!(values["Output"], s(&d.join("out.####.exr")));
@@ -115,7 +120,7 @@ fn a_job_bundle_holds_the_command_line_as_the_template_takes_it() {
     // And as Deadline Cloud reads them.
     let deadline = std::fs::read_to_string(job.join("parameter_values.yaml")).unwrap();
     assert!(deadline.starts_with("parameterValues:\n  - name: Morphfx\n    value: \"morphfx\"\n"));
-    assert!(deadline.contains("  - name: ExtraArgs\n    value: \"--t 0.3\"\n"));
+    assert!(deadline.contains(&format!("  - name: ExtraArgs\n    value: \"{extra}\"\n")));
 }
 
 #[test]

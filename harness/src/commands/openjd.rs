@@ -127,6 +127,9 @@ struct Options {
 /// Options the template carries as parameters, each with a value.
 const CARRIED: [&str; 6] = ["--scene", "--a", "--b", "--input", "--frames", "-o"];
 
+/// Further options whose values are files, passed on in the extra arguments.
+const PATHS: [&str; 5] = ["--mask", "--timing", "--stmap", "--stmap-a", "--stmap-b"];
+
 impl Options {
     fn parse(args: &[String]) -> Result<Options, HostError> {
         let mut pairs = Vec::new();
@@ -146,6 +149,16 @@ impl Options {
                     })?,
                 };
                 pairs.push((flag.to_owned(), value));
+            } else if PATHS.contains(&flag) {
+                // Workers start elsewhere: their files by absolute path.
+                let value = match inline {
+                    Some(v) => v,
+                    None => args.next().cloned().ok_or_else(|| {
+                        HostError::bad(format!("morphfx job openjd: {flag} needs a value"))
+                    })?,
+                };
+                rest.push(flag.to_owned());
+                rest.push(absolute(Path::new(&value))?);
             } else {
                 rest.push(arg.clone());
             }
