@@ -143,6 +143,30 @@ fn mask_and_mix_dial_the_effect_back_at_every_depth() {
                 }
                 assert!(moved > 100, "{id}: the effect reaches the output ({moved})");
             }
+            // Alpha-only and RGB outputs mix like to like.
+            for channels in [1, 3] {
+                let out = OutputSpec {
+                    channels,
+                    ..spec(depth)
+                };
+                masked.set_int("mask_invert", 0).unwrap();
+                let effect = plain.render(1.0, out).unwrap().to_image();
+                let got = masked.render(1.0, out).unwrap().to_image();
+                for j in 0..H as i32 {
+                    for i in 0..W as i32 {
+                        for c in 0..channels {
+                            let s = src.pixel(i, j)[if channels == 1 { 3 } else { c }];
+                            let e = effect.pixel(i, j)[c];
+                            let want = s + (e - s) * 0.7 * alpha(i, j);
+                            let g = got.pixel(i, j)[c];
+                            assert!(
+                                (g - want).abs() <= code(depth),
+                                "{id} {depth} {channels} channels ({i}, {j}) {c}: {g} vs {want}"
+                            );
+                        }
+                    }
+                }
+            }
             // Mix 0: the source, unchanged, as the identity action says.
             masked.set_double("mix", &[0.0], None).unwrap();
             let id_spec = OutputSpec {
