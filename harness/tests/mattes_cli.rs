@@ -71,25 +71,29 @@ fn read(p: &Path, colour: Colour) -> Image {
     io::read_as(p, colour).unwrap().image
 }
 
-#[test]
-fn a_mask_and_mix_through_exr_and_png_match_the_closed_form() {
-    let d = common::scratch("mask-cli");
-    let a = plate(&d, "a.exr", 0.0);
-    let (mask, m) = mask_png(&d);
+/// The full warp of plate `a` at t = 1, no mask, and the plate itself.
+fn unmasked(d: &Path, a: &Path) -> (Image, Image) {
     let full = d.join("full.exr");
     ok(&[
         "warp",
         "--line",
         LINE,
         "--input",
-        s(&a),
+        s(a),
         "--t",
         "1",
         "-o",
         s(&full),
     ]);
-    let effect = read(&full, Colour::Raw);
-    let src = read(&a, Colour::Raw);
+    (read(&full, Colour::Raw), read(a, Colour::Raw))
+}
+
+#[test]
+fn a_mask_and_mix_through_exr_and_png_match_the_closed_form() {
+    let d = common::scratch("mask-cli");
+    let a = plate(&d, "a.exr", 0.0);
+    let (mask, m) = mask_png(&d);
+    let (effect, src) = unmasked(&d, &a);
     // The mask's pixel rows are numbered from its own top: its display
     // window is 40 high, bottom-aligned with the plates' origin.
     let alpha = |i: i32, j: i32| {
@@ -283,19 +287,7 @@ fn keyed_params_interpolate_and_params_lists_every_id() {
         "-o",
         s(&out),
     ]);
-    let full = d.join("full.exr");
-    ok(&[
-        "warp",
-        "--line",
-        LINE,
-        "--input",
-        s(&a),
-        "--t",
-        "1",
-        "-o",
-        s(&full),
-    ]);
-    let (effect, src) = (read(&full, Colour::Raw), read(&a, Colour::Raw));
+    let (effect, src) = unmasked(&d, &a);
     for (f, mix) in [(1, 0.0f32), (2, 0.5), (3, 1.0)] {
         let got = read(&d.join(format!("o.{f:04}.exr")), Colour::Raw);
         for (k, g) in got.data.iter().enumerate() {

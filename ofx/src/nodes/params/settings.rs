@@ -175,7 +175,12 @@ pub(super) fn transition_settings(r: &Reader<'_>) -> TransitionSettings {
         pattern,
         spread: r.double(&TRANSITION_SPREAD),
     });
-    match r.choice(&TRANSITION_AFFECTS) {
+    pacing(t, r.choice(&TRANSITION_AFFECTS))
+}
+
+/// `t` on what `affects` names, the rest uniform.
+pub fn pacing(t: Transition, affects: Affects) -> TransitionSettings {
+    match affects {
         Affects::Both => TransitionSettings {
             geometry: t,
             colour: None,

@@ -9,7 +9,7 @@ use morphfx::image::Sample;
 use morphfx::transition::{Matte, Transition, TransitionSettings};
 
 use super::scale_of;
-use crate::nodes::params::{Affects, Settings};
+use crate::nodes::params::{pacing, Settings};
 use crate::wrapper::clips::{Depth, HostImage};
 use crate::wrapper::{Failure, Outcome};
 
@@ -45,18 +45,5 @@ pub(super) fn timed(matte: Matte, settings: &Settings) -> TransitionSettings {
         matte: Arc::new(matte),
         spread: settings.spread,
     };
-    match settings.affects {
-        Affects::Both => TransitionSettings {
-            geometry: t,
-            colour: None,
-        },
-        Affects::Geometry => TransitionSettings {
-            geometry: t,
-            colour: Some(Transition::Uniform),
-        },
-        Affects::Colour => TransitionSettings {
-            geometry: Transition::Uniform,
-            colour: Some(t),
-        },
-    }
+    pacing(t, settings.affects)
 }
