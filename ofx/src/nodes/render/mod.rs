@@ -313,7 +313,7 @@ fn prepare<'r>(kind: NodeKind, instance: &'r NodeState, request: &'r Request) ->
         inputs.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
     }
     let two_pass = mesh && inputs.warp.settings.mesh.pass == Pass::TwoPass;
-    let picture = matches!(view, View::Morph | View::WarpedA | View::WarpedB);
+    let picture = view.is_picture();
     // A non-uniform colour transition weighs every pixel of the dissolve.
     let weighted = matches!(view, View::Morph | View::Folds)
         && kind == NodeKind::Morph
