@@ -135,6 +135,12 @@ pub struct ShotMotion {
     pub bend_at: Vec2,
     /// The bend's Gaussian radius.
     pub bend_radius: f64,
+    /// Peak displacement, at the last frame, of a wave across the frame:
+    /// a bend that varies along any long feature.
+    pub wave: Vec2,
+    /// The wave's length, pixels, along the diagonal (x + y); keep
+    /// `|wave| · 2π / wavelength` well under 1 so the motion stays one-to-one.
+    pub wavelength: f64,
 }
 
 impl ShotMotion {
@@ -146,7 +152,14 @@ impl ShotMotion {
         let d = p - self.centre;
         let turned = Vec2::new(cos * d.x - sin * d.y, sin * d.x + cos * d.y) * zoom;
         let r2 = (p - self.bend_at).length_squared() / (2.0 * self.bend_radius.powi(2));
-        self.centre + turned + self.drift * s + self.bend * (s * (-r2).exp())
+        let phase = std::f64::consts::TAU * (p.x + p.y)
+            / std::f64::consts::SQRT_2
+            / self.wavelength.max(1e-9);
+        self.centre
+            + turned
+            + self.drift * s
+            + self.bend * (s * (-r2).exp())
+            + self.wave * (s * phase.sin())
     }
 
     /// The point of frame 0 that lands at `x` in frame `frame` (Newton's

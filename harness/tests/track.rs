@@ -31,6 +31,8 @@ fn motion() -> ShotMotion {
         bend: Vec2::new(3.0, 1.5),
         bend_at: Vec2::new(200.0, 100.0),
         bend_radius: 60.0,
+        wave: Vec2::ZERO,
+        wavelength: 1.0,
     }
 }
 
@@ -321,6 +323,8 @@ fn button_motion() -> ShotMotion {
         bend: Vec2::ZERO,
         bend_at: Vec2::ZERO,
         bend_radius: 1.0,
+        wave: Vec2::ZERO,
+        wavelength: 1.0,
     }
 }
 

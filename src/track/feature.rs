@@ -1,7 +1,9 @@
 //! One side (A or B) of one feature followed through a sweep of frames.
 //!
 //! Points, polylines and curves: each control point is tracked on its own.
-//! A line is tracked along its whole length: patches spaced along it are
+//! A line's ends follow their own matches where those can be trusted (a
+//! corner, matched well): a motion that bends along the line moves each
+//! end its own way. Elsewhere the line is tracked along its whole length: patches spaced along it are
 //! tracked, and one affine motion is fitted to all of them, each patch
 //! weighted by how firmly its texture fixes each direction (a patch on the
 //! line's edge fixes only the across-edge position; one on a corner fixes
@@ -35,6 +37,8 @@ pub struct SideTracker {
     key_points: Vec<Vec2>,
     /// Key positions of the tracked patches and their trackers.
     samples: Vec<(Vec2, PointTracker)>,
+    /// Lines: whether each end's own patch was found in some frame so far.
+    ends_seen: [bool; 2],
 }
 
 /// Patches along a line: about one per patch radius, ends included.
@@ -65,6 +69,7 @@ impl SideTracker {
                 .into_iter()
                 .map(|p| (p, PointTracker::new(key, p, settings)))
                 .collect(),
+            ends_seen: [false; 2],
         }
     }
 
@@ -95,11 +100,28 @@ impl SideTracker {
                 .collect();
             c.iter().sum::<f64>() / c.len().max(1) as f64
         };
-        SideEstimate {
-            points: self.key_points.iter().map(|&k| motion(k)).collect(),
-            confidence: vec![confidence; 2],
-            lost: vec![lost; 2],
+        let mut side = SideEstimate {
+            points: Vec::new(),
+            confidence: Vec::new(),
+            lost: Vec::new(),
+        };
+        // The ends are the first and last samples.
+        let last = self.samples.len() - 1;
+        for (n, (key, k)) in self.key_points.iter().zip([0, last]).enumerate() {
+            let end = End {
+                own: &found[k],
+                information: self.samples[k].1.information(),
+                seen: self.ends_seen[n],
+                fit: motion(*key),
+                line_confidence: confidence,
+            }
+            .decide();
+            self.ends_seen[n] |= !found[k].lost;
+            side.points.push(end.at);
+            side.confidence.push(end.confidence);
+            side.lost.push(lost || end.doubtful);
         }
+        side
     }
 
     /// The affine motion `k ↦ t + G (k - k̄)` that best explains the used
@@ -144,6 +166,87 @@ impl SideTracker {
         move |k: Vec2| match &q {
             Some(q) => apply(q, k),
             None => k + mean_shift,
+        }
+    }
+}
+
+/// One end of a line in one frame: its own match, and where the line's
+/// fit puts it.
+struct End<'a> {
+    own: &'a Estimate,
+    /// How firmly the end's own patch fixes each direction, `[xx, xy, yy]`.
+    information: [f64; 3],
+    /// Whether the end's own match has found it in an earlier frame of the
+    /// sweep: lost now, it is hidden or changed, and the fit there is a
+    /// guess. (An end on flat ground is never found: the fit is all there is.)
+    seen: bool,
+    fit: Vec2,
+    line_confidence: f64,
+}
+
+/// Where an end is reported, how surely, and whether it is in doubt.
+struct EndEstimate {
+    at: Vec2,
+    confidence: f64,
+    doubtful: bool,
+}
+
+/// The smaller and larger eigenvalues of a patch's information `[xx, xy, yy]`.
+fn eigen([xx, xy, yy]: [f64; 3]) -> (f64, f64) {
+    let (mean, spread) = (0.5 * (xx + yy), (0.25 * (xx - yy).powi(2) + xy * xy).sqrt());
+    (mean - spread, mean + spread)
+}
+
+/// An end's own match is taken over the line's fit when its patch fixes
+/// both directions (the smaller eigenvalue of its information at least
+/// this share of the larger: a corner, not an edge)...
+const CORNER_RATIO: f64 = 0.1;
+/// ...and it matches the key at least this well.
+const OWN_CONFIDENCE: f64 = 0.9;
+/// An end reported from the fit is in doubt when its own match disagrees by
+/// more than this, pixels, in the directions its patch fixes.
+const DISAGREEMENT_PX: f64 = 0.75;
+
+impl End<'_> {
+    /// Each end follows its own local motion where its patch can say
+    /// (under a motion that bends along the line, a whole-line fit slides
+    /// the ends off their corners); elsewhere the fit, the only evidence on
+    /// flat ground. The fit's answer is in doubt where the end's own match
+    /// contradicts it in a direction its texture fixes, or where an end
+    /// found before is lost (hidden): reported, never passed off as found.
+    fn decide(&self) -> EndEstimate {
+        let [xx, xy, yy] = self.information;
+        let (small, large) = eigen(self.information);
+        let own = self.own;
+        let corner = large > 0.0 && small >= CORNER_RATIO * large;
+        if corner && !own.lost && own.confidence >= OWN_CONFIDENCE {
+            return EndEstimate {
+                at: own.at,
+                confidence: own.confidence,
+                doubtful: false,
+            };
+        }
+        // The gap along the directions the patch fixes: an edge's across
+        // it, a corner's both, a flat patch's none.
+        let d = own.at - self.fit;
+        let fixed = if large > 0.0 {
+            ((xx * d.x * d.x + 2.0 * xy * d.x * d.y + yy * d.y * d.y) / large).sqrt()
+        } else {
+            0.0
+        };
+        let doubtful = if own.lost {
+            self.seen
+        } else {
+            fixed > DISAGREEMENT_PX
+        };
+        EndEstimate {
+            at: self.fit,
+            confidence: if doubtful {
+                self.line_confidence.min(own.confidence) * 0.5
+            } else {
+                self.line_confidence
+            },
+            doubtful,
         }
     }
 }

@@ -44,6 +44,8 @@ fn affine() -> ShotMotion {
         bend: Vec2::ZERO,
         bend_at: Vec2::ZERO,
         bend_radius: 1.0,
+        wave: Vec2::ZERO,
+        wavelength: 1.0,
     }
 }
 
