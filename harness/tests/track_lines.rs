@@ -153,6 +153,9 @@ fn line_ends_stay_on_their_corners_as_the_motion_bends_along_the_line() {
         frame: 0,
         points: keyed.clone(),
     };
+    if let Some(dir) = std::env::var_os("MORPHFX_TRACK_DUMP") {
+        dump(Path::new(&dir), &frames, &keyed, &motion);
+    }
     let tracked = track_side(
         &kinds,
         &[key],
@@ -246,4 +249,43 @@ fn an_occluded_line_end_is_flagged_while_hidden_and_found_again() {
             assert!(error <= 0.3, "frame {f}: found again {error:.3} px off");
         }
     }
+}
+
+/// The shot for a peer tracker (`benches/lk_peer.py`): its frames as 8-bit
+/// grey PNGs and, in `shot.json`, every keyed position and where it truly is in
+/// each frame (canonical, y up).
+fn dump(dir: &Path, frames: &[Image], keyed: &[Vec<Vec2>], motion: &ShotMotion) {
+    std::fs::create_dir_all(dir).unwrap();
+    // LK takes 8 bits: Rec. 709 luminance, a 1/2.2 gamma, raw code values.
+    let format = io::OutputFormat {
+        colour: io::Colour::Raw,
+        ..io::OutputFormat::new(io::ExrPrecision::Float)
+    };
+    for (f, img) in frames.iter().enumerate() {
+        let grey = Image::from_fn(img.bounds, 4, |i, j, c| {
+            let p = img.pixel(i, j);
+            let y = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            if c == 3 {
+                1.0
+            } else {
+                y.max(0.0).powf(1.0 / 2.2)
+            }
+        });
+        let plate = io::Plate::new(grey, (img.width(), img.height()));
+        io::write_as(&dir.join(format!("frame.{f:04}.png")), &plate, format).unwrap();
+    }
+    let points: Vec<Vec2> = keyed.iter().flatten().copied().collect();
+    let truth: Vec<Vec<[f64; 2]>> = (0..frames.len())
+        .map(|f| {
+            points
+                .iter()
+                .map(|p| {
+                    let q = motion.at(f, *p);
+                    [q.x, q.y]
+                })
+                .collect()
+        })
+        .collect();
+    let json = serde_json::json!({ "height": frames[0].height(), "truth": truth });
+    std::fs::write(dir.join("shot.json"), json.to_string()).unwrap();
 }
