@@ -3,6 +3,8 @@
 
 mod common;
 
+use common::{percentile, pyramids};
+
 use std::path::Path;
 use std::sync::Arc;
 
@@ -10,7 +12,7 @@ use morphfx::features::FeatureKind;
 use morphfx::geom::Vec2;
 use morphfx::image::Image;
 use morphfx::testing::{corners, shot_frame, ShotMotion};
-use morphfx::track::{track_side, Frames, Grey, Pyramid, SideKey, TrackSettings};
+use morphfx::track::{track_side, SideKey, TrackSettings};
 use morphfx_harness::io;
 
 /// Venice at dusk (Poly Haven, CC0): 512 × 256, half-float HDR.
@@ -34,33 +36,6 @@ fn motion() -> ShotMotion {
         wave: Vec2::ZERO,
         wavelength: 1.0,
     }
-}
-
-struct InMemory(Vec<Arc<Pyramid>>);
-
-impl Frames<morphfx::Error> for InMemory {
-    fn pyramid(&mut self, frame: i64) -> morphfx::Result<Arc<Pyramid>> {
-        Ok(self.0[frame as usize].clone())
-    }
-}
-
-fn pyramids(frames: &[Image], settings: &TrackSettings) -> InMemory {
-    InMemory(
-        frames
-            .iter()
-            .map(|f| {
-                Arc::new(Pyramid::new(
-                    Grey::from_view(&f.view()),
-                    settings.levels,
-                    16,
-                ))
-            })
-            .collect(),
-    )
-}
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
 
 #[test]

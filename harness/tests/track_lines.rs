@@ -4,14 +4,15 @@
 
 mod common;
 
+use common::{percentile, pyramids};
+
 use std::path::Path;
-use std::sync::Arc;
 
 use morphfx::features::FeatureKind;
 use morphfx::geom::Vec2;
 use morphfx::image::Image;
 use morphfx::testing::{corners, shot_frame, ShotMotion};
-use morphfx::track::{track_side, Frames, Grey, Pyramid, SideKey, TrackSettings};
+use morphfx::track::{track_side, SideKey, TrackSettings};
 use morphfx_harness::io;
 
 /// A studio interior (Poly Haven, CC0): 512 × 256, half-float HDR.
@@ -36,33 +37,6 @@ fn motion() -> ShotMotion {
         wave: Vec2::new(3.0, -2.5),
         wavelength: 260.0,
     }
-}
-
-struct InMemory(Vec<Arc<Pyramid>>);
-
-impl Frames<morphfx::Error> for InMemory {
-    fn pyramid(&mut self, frame: i64) -> morphfx::Result<Arc<Pyramid>> {
-        Ok(self.0[frame as usize].clone())
-    }
-}
-
-fn pyramids(frames: &[Image], settings: &TrackSettings) -> InMemory {
-    InMemory(
-        frames
-            .iter()
-            .map(|f| {
-                Arc::new(Pyramid::new(
-                    Grey::from_view(&f.view()),
-                    settings.levels,
-                    16,
-                ))
-            })
-            .collect(),
-    )
-}
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
 
 /// Corners a user would key, staying `margin` inside the frame all shot long.

@@ -127,3 +127,40 @@ impl morphfx_harness::host::FrameSource for Still {
         Ok(self.0.clone())
     }
 }
+
+/// A shot's pyramids held in memory, as the tracker asks for them.
+#[allow(dead_code)] // the tracking tests only
+pub struct InMemory(pub Vec<std::sync::Arc<morphfx::track::Pyramid>>);
+
+impl morphfx::track::Frames<morphfx::Error> for InMemory {
+    fn pyramid(&mut self, frame: i64) -> morphfx::Result<std::sync::Arc<morphfx::track::Pyramid>> {
+        Ok(self.0[frame as usize].clone())
+    }
+}
+
+/// Every frame's grey pyramid, as the tracker builds them.
+#[allow(dead_code)] // the tracking tests only
+pub fn pyramids(
+    frames: &[morphfx::image::Image],
+    settings: &morphfx::track::TrackSettings,
+) -> InMemory {
+    use morphfx::track::{Grey, Pyramid};
+    InMemory(
+        frames
+            .iter()
+            .map(|f| {
+                std::sync::Arc::new(Pyramid::new(
+                    Grey::from_view(&f.view()),
+                    settings.levels,
+                    16,
+                ))
+            })
+            .collect(),
+    )
+}
+
+/// The `p` quantile of `sorted`, the nearest rank.
+#[allow(dead_code)] // the tracking tests only
+pub fn percentile(sorted: &[f64], p: f64) -> f64 {
+    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
+}
