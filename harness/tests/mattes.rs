@@ -405,3 +405,59 @@ fn the_folds_view_marks_where_a_numeric_jacobian_turns_over() {
         );
     }
 }
+
+/// At render scale 0.5 (a proxy) the mask lines up by canonical position:
+/// each output pixel takes the half-resolution mask's alpha there, and the
+/// closed form holds against the proxy effect and source as the host
+/// scaled them.
+#[test]
+fn the_mask_lines_up_at_half_render_scale() {
+    let (a, b) = (plate(0.0), plate(2.0));
+    let mask = mask_image();
+    let half = OutputSpec {
+        render_scale: (0.5, 0.5),
+        ..spec("OfxBitDepthFloat")
+    };
+    let plain = node(
+        "net.morphfx.Warp",
+        "OfxImageEffectContextFilter",
+        "OfxBitDepthFloat",
+        &a,
+        &b,
+    );
+    let effect = plain.render(1.0, half).unwrap().to_image();
+    let masked = node(
+        "net.morphfx.Warp",
+        "OfxImageEffectContextFilter",
+        "OfxBitDepthFloat",
+        &a,
+        &b,
+    );
+    masked
+        .connect("Mask", still(&mask, "OfxBitDepthFloat"))
+        .unwrap();
+    masked.set_double("mix", &[0.7], None).unwrap();
+    let got = masked.render(1.0, half).unwrap().to_image();
+    // What the plugin is handed at this scale.
+    let scaled = |img: &Image| {
+        Frame::from_image(img, "OfxBitDepthFloat", false)
+            .scaled((0.5, 0.5))
+            .to_image()
+    };
+    let (src, m) = (scaled(&a), scaled(&mask));
+    let mut masked_pixels = 0;
+    for j in got.bounds.y1..got.bounds.y2 {
+        for i in got.bounds.x1..got.bounds.x2 {
+            let inside = m.bounds.contains(&RectI::new(i, j, i + 1, j + 1));
+            let alpha = if inside { m.pixel(i, j)[0] } else { 0.0 };
+            masked_pixels += (alpha > 0.0) as usize;
+            for c in 0..4 {
+                let (e, s) = (effect.pixel(i, j)[c], src.pixel(i, j)[c]);
+                let want = s + (e - s) * 0.7 * alpha;
+                let g = got.pixel(i, j)[c];
+                assert!((g - want).abs() < 1e-5, "({i}, {j}) {c}: {g} vs {want}");
+            }
+        }
+    }
+    assert!(masked_pixels > 100);
+}
