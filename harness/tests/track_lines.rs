@@ -15,7 +15,7 @@ use morphfx::testing::{corners, shot_frame, ShotMotion};
 use morphfx::track::{track_side, SideKey, TrackSettings};
 use morphfx_harness::io;
 
-/// A studio interior (Poly Haven, CC0): 512 × 256, half-float HDR.
+/// A forest (Poly Haven, CC0): 512 × 256, half-float HDR.
 fn photo() -> Image {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/forest.exr");
     io::read(&path).expect("the test photo reads").image
@@ -37,6 +37,24 @@ fn motion() -> ShotMotion {
         wave: Vec2::new(3.0, -2.5),
         wavelength: 260.0,
     }
+}
+
+/// The features keyed at frame 0 followed to the last frame, default settings.
+fn track_from_key(
+    kinds: &[FeatureKind],
+    key: SideKey,
+    frames: &[Image],
+) -> Vec<Vec<morphfx::track::SideEstimate>> {
+    let settings = TrackSettings::default();
+    track_side(
+        kinds,
+        &[key],
+        (0, frames.len() as i64 - 1),
+        &mut pyramids(frames, &settings),
+        &settings,
+        &mut |_, _, _| true,
+    )
+    .unwrap()
 }
 
 /// Corners a user would key, staying `margin` inside the frame all shot long.
@@ -113,7 +131,6 @@ fn line_ends_stay_on_their_corners_as_the_motion_bends_along_the_line() {
     // tracked as points are.
     let polyline: Vec<Vec2> = rest.iter().copied().skip(12).take(3).collect();
     assert!(lines.len() == 4 && points.len() == 12 && polyline.len() == 3);
-    let settings = TrackSettings::default();
     let mut kinds = vec![FeatureKind::Line; lines.len()];
     kinds.extend(vec![FeatureKind::Point; points.len()]);
     kinds.push(FeatureKind::Polyline);
@@ -130,15 +147,7 @@ fn line_ends_stay_on_their_corners_as_the_motion_bends_along_the_line() {
     if let Some(dir) = std::env::var_os("MORPHFX_TRACK_DUMP") {
         dump(Path::new(&dir), &frames, &keyed, &motion);
     }
-    let tracked = track_side(
-        &kinds,
-        &[key],
-        (0, motion.frames as i64),
-        &mut pyramids(&frames, &settings),
-        &settings,
-        &mut |_, _, _| true,
-    )
-    .unwrap();
+    let tracked = track_from_key(&kinds, key, &frames);
     let (mut ends, mut all) = (Scored { errors: Vec::new() }, Scored { errors: Vec::new() });
     let mut unflagged = Vec::new();
     for (f, estimates) in tracked.iter().enumerate().skip(1) {
@@ -189,20 +198,11 @@ fn an_occluded_line_end_is_flagged_while_hidden_and_found_again() {
             }
         }
     }
-    let settings = TrackSettings::default();
     let key = SideKey {
         frame: 0,
         points: vec![line.to_vec()],
     };
-    let tracked = track_side(
-        &[FeatureKind::Line],
-        &[key],
-        (0, motion.frames as i64),
-        &mut pyramids(&frames, &settings),
-        &settings,
-        &mut |_, _, _| true,
-    )
-    .unwrap();
+    let tracked = track_from_key(&[FeatureKind::Line], key, &frames);
     for (f, estimates) in tracked.iter().enumerate().skip(1) {
         let e = &estimates[0];
         for (i, p) in line.iter().enumerate() {
