@@ -3,7 +3,7 @@
 //! the same warp maps as the morph itself.
 
 use crate::choice::Choice;
-use crate::features::{sample_points, Feature, FeatureKind};
+use crate::features::{outline, Feature, FeatureKind};
 use crate::geom::Vec2;
 use crate::image::resample::fill_rows;
 use crate::image::WarpMap;
@@ -119,7 +119,8 @@ pub fn grid<D: Sample>(map: &WarpMap, features: &[Feature], t: f64, dst: RowsMut
         .flat_map(|f| {
             let pts = f.points_at(t);
             let pts = match f.kind {
-                FeatureKind::Curve => sample_points(FeatureKind::Curve, &pts, 8),
+                FeatureKind::Curve => outline(FeatureKind::Curve, f.closed, &pts, 8),
+                FeatureKind::Polyline => outline(FeatureKind::Polyline, f.closed, &pts, 1),
                 _ => pts,
             };
             if pts.len() == 1 {

@@ -44,6 +44,7 @@ fn features() -> Vec<Feature> {
             kind: FeatureKind::Line,
             a: vec![v(a0), v(a1)],
             b: vec![v(b0), v(b1)],
+            closed: false,
         })
         .collect()
 }

@@ -10,7 +10,23 @@ pub fn catmull_rom(points: &[Vec2], span: usize, s: f64) -> Vec2 {
     debug_assert!(n >= 2 && span + 1 < n);
     let p = |i: isize| points[i.clamp(0, n as isize - 1) as usize];
     let i = span as isize;
-    let (p0, p1, p2, p3) = (p(i - 1), p(i), p(i + 1), p(i + 2));
+    cubic([p(i - 1), p(i), p(i + 1), p(i + 2)], s)
+}
+
+/// Position on the closed Catmull-Rom loop through `points` at span `span`
+/// (from `points[span]` to the next point, the last span back to the
+/// first), local parameter `s` in `[0, 1]`: neighbours wrap around, so the
+/// loop is C¹ at every control point, the first included.
+pub fn catmull_rom_closed(points: &[Vec2], span: usize, s: f64) -> Vec2 {
+    let n = points.len() as isize;
+    debug_assert!(n >= 2 && (span as isize) < n);
+    let p = |i: isize| points[i.rem_euclid(n) as usize];
+    let i = span as isize;
+    cubic([p(i - 1), p(i), p(i + 1), p(i + 2)], s)
+}
+
+/// The uniform Catmull-Rom cubic between `p1` and `p2`.
+fn cubic([p0, p1, p2, p3]: [Vec2; 4], s: f64) -> Vec2 {
     let s2 = s * s;
     let s3 = s2 * s;
     // 0.5 * (2 P1 + (P2 - P0) s + (2 P0 - 5 P1 + 4 P2 - P3) s² + (3 P1 - P0 - 3 P2 + P3) s³)
@@ -38,6 +54,28 @@ mod tests {
             let end = catmull_rom(&pts, span, 1.0);
             assert!(end.distance(pts[span + 1]) < 1e-12);
         }
+    }
+
+    #[test]
+    fn a_closed_loop_passes_through_every_point_and_is_smooth_at_the_first() {
+        let pts = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(10.0, 0.0),
+            Vec2::new(10.0, 10.0),
+            Vec2::new(0.0, 10.0),
+        ];
+        for span in 0..4 {
+            assert_eq!(catmull_rom_closed(&pts, span, 0.0), pts[span]);
+            let end = catmull_rom_closed(&pts, span, 1.0);
+            assert!(end.distance(pts[(span + 1) % 4]) < 1e-12);
+        }
+        // The tangent leaving the first point equals the one arriving at it
+        // (both (P1 - P3) / 2 by symmetry of the wrap).
+        let h = 1e-6;
+        let leave = (catmull_rom_closed(&pts, 0, h) - pts[0]) * (1.0 / h);
+        let arrive = (pts[0] - catmull_rom_closed(&pts, 3, 1.0 - h)) * (1.0 / h);
+        assert!(leave.distance(arrive) < 1e-4, "{leave:?} {arrive:?}");
+        assert!(leave.distance(Vec2::new(5.0, -5.0)) < 1e-4, "{leave:?}");
     }
 
     #[test]

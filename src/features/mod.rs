@@ -4,8 +4,8 @@
 mod catmull_rom;
 mod sampling;
 
-pub use catmull_rom::catmull_rom;
-pub use sampling::{sample_points, PointPair, DEFAULT_SAMPLES_PER_SEGMENT};
+pub use catmull_rom::{catmull_rom, catmull_rom_closed};
+pub use sampling::{outline, sample_points, PointPair, DEFAULT_SAMPLES_PER_SEGMENT};
 
 use crate::geom::Vec2;
 
@@ -68,6 +68,9 @@ pub struct Feature {
     pub a: Vec<Vec2>,
     /// Control points on image B, one per point on A.
     pub b: Vec<Vec2>,
+    /// A polyline or curve that runs on from its last point back to its
+    /// first (scene key `closed`); always false for points and lines.
+    pub closed: bool,
 }
 
 /// Where a feature sits on one image, or in between.
@@ -87,7 +90,14 @@ impl Feature {
             kind,
             a,
             b,
+            closed: false,
         }
+    }
+
+    /// The same feature closed (a loop) or open; points and lines stay open.
+    pub fn closed(mut self, closed: bool) -> Self {
+        self.closed = closed && matches!(self.kind, FeatureKind::Polyline | FeatureKind::Curve);
+        self
     }
 
     /// A directed line: `a[0] → a[1]` on A, `b[0] → b[1]` on B.

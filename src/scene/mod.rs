@@ -77,6 +77,7 @@ impl Scene {
                 kind: f0.kind,
                 a: lerp_points(&f0.a, &f1.a, w),
                 b: lerp_points(&f0.b, &f1.b, w),
+                closed: f0.closed,
             })
             .collect()
     }

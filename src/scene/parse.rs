@@ -92,6 +92,7 @@ struct RawFeature {
     kind: String,
     a: Vec<[f64; 2]>,
     b: Vec<[f64; 2]>,
+    closed: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -414,8 +415,19 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
             ),
         ));
     }
+    let closed = raw.closed.unwrap_or(false);
     let (min, max) = kind.point_count();
+    let min = if closed { 3 } else { min };
     let n = raw.a.len();
+    if closed && !matches!(kind, FeatureKind::Polyline | FeatureKind::Curve) {
+        return Err(Error::scene(
+            &at,
+            format!(
+                "a {} cannot be closed (only polylines and curves take \"closed\")",
+                kind.name()
+            ),
+        ));
+    }
     if n < min || n > max {
         let want = if min == max {
             format!("exactly {min}")
@@ -424,7 +436,11 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
         };
         return Err(Error::scene(
             &at,
-            format!("a {} needs {want} points, found {n}", kind.name()),
+            format!(
+                "a {}{} needs {want} points, found {n}",
+                if closed { "closed " } else { "" },
+                kind.name()
+            ),
         ));
     }
     let side = |pts: Vec<[f64; 2]>, side: &str| -> Result<Vec<Vec2>> {
@@ -447,6 +463,15 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
                     format!("{side}[{i}] and {side}[{}]: {what}", i + 1),
                 ));
             }
+            if closed && pts.first() == pts.last() {
+                return Err(Error::scene(
+                    &at,
+                    format!(
+                        "{side}[{}] repeats {side}[0]: a closed shape returns to its first point by itself",
+                        pts.len() - 1
+                    ),
+                ));
+            }
         }
         Ok(pts)
     };
@@ -455,6 +480,7 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
         kind,
         a: side(raw.a, "a")?,
         b: side(raw.b, "b")?,
+        closed,
     })
 }
 
@@ -503,7 +529,7 @@ fn same_feature_list(first: &Keyframe, features: &[Feature], at: &str) -> Result
         ));
     }
     for (i, (r, f)) in reference.iter().zip(features).enumerate() {
-        if r.kind != f.kind || r.a.len() != f.a.len() || r.name != f.name {
+        if r.kind != f.kind || r.a.len() != f.a.len() || r.name != f.name || r.closed != f.closed {
             return Err(Error::scene(
                 format!("{at} {}", f.label(i)),
                 format!(

@@ -447,3 +447,47 @@ fn bad_meshes_name_the_mesh_and_the_place() {
         "{at}: {msg}"
     );
 }
+
+#[test]
+fn closed_polylines_and_curves_parse_and_bad_ones_are_refused() {
+    let one = |f: &str| format!(r#"{{"features": [{f}]}}"#);
+    let s = Scene::parse(&one(
+        r#"{"type": "curve", "closed": true, "a": [[0,0],[10,0],[5,8]], "b": [[0,0],[10,0],[5,9]]}"#,
+    ))
+    .unwrap();
+    assert!(s.features[0].closed);
+    // Old scenes, and "closed": false, read open.
+    let s = Scene::parse(GOOD).unwrap();
+    assert!(s.features.iter().all(|f| !f.closed));
+    let s = Scene::parse(&one(
+        r#"{"type": "line", "closed": false, "a": [[0,0],[1,0]], "b": [[0,0],[1,0]]}"#,
+    ))
+    .unwrap();
+    assert!(!s.features[0].closed);
+    assert_refused(
+        &one(r#"{"type": "line", "closed": true, "a": [[0,0],[1,0]], "b": [[0,0],[1,0]]}"#),
+        "features[0]",
+        "a line cannot be closed",
+    );
+    assert_refused(
+        &one(r#"{"type": "polyline", "closed": true, "a": [[0,0],[1,0]], "b": [[0,0],[1,0]]}"#),
+        "features[0]",
+        "a closed polyline needs at least 3 points",
+    );
+    assert_refused(
+        &one(
+            r#"{"type": "polyline", "closed": true, "a": [[0,0],[1,0],[1,1],[0,0]], "b": [[0,0],[1,0],[1,1],[0,1]]}"#,
+        ),
+        "features[0]",
+        "a[3] repeats a[0]",
+    );
+    // Keyframes must agree on closure.
+    assert_refused(
+        r#"{"keyframes": [
+            {"frame": 1, "features": [{"type": "polyline", "closed": true, "a": [[0,0],[1,0],[1,1]], "b": [[0,0],[1,0],[1,1]]}]},
+            {"frame": 2, "features": [{"type": "polyline", "a": [[0,0],[1,0],[1,1]], "b": [[0,0],[1,0],[1,1]]}]}
+        ]}"#,
+        "keyframes[1]",
+        "every keyframe must hold the same features",
+    );
+}

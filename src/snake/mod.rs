@@ -66,7 +66,7 @@ impl Snake {
     /// Samples a polyline or curve `per_segment` times per span (seed §4.2).
     pub fn from_primitive(kind: FeatureKind, controls: &[Vec2], settings: &SnakeSettings) -> Snake {
         let per = settings.samples_per_segment.max(1);
-        let points = sample_points(kind, controls, per);
+        let points = sample_points(kind, false, controls, per);
         let controls: Vec<usize> = match kind {
             FeatureKind::Polyline | FeatureKind::Curve => {
                 (0..controls.len()).map(|k| k * per).collect()

@@ -1,7 +1,7 @@
 //! Features as Beier-Neely line pairs, and lines interpolated over `t`.
 
 use super::{FieldSettings, LineInterpolation};
-use crate::features::{sample_points, Feature, FeatureKind, Side, Tween};
+use crate::features::{Feature, FeatureKind, Side, Tween};
 use crate::geom::Vec2;
 
 /// A directed segment in the output (`dst`) and where it comes from in the
@@ -58,8 +58,14 @@ fn segments(f: &Feature, side: Side, settings: &FieldSettings) -> Vec<(Vec2, Vec
     let pts = f.points(side);
     match f.kind {
         FeatureKind::Point => vec![(pts[0], pts[0] + Vec2::new(1.0, 0.0))],
-        FeatureKind::Line | FeatureKind::Polyline => pts.windows(2).map(|w| (w[0], w[1])).collect(),
-        FeatureKind::Curve => sample_points(FeatureKind::Curve, pts, settings.curve_samples)
+        FeatureKind::Line => vec![(pts[0], pts[1])],
+        FeatureKind::Polyline => f
+            .outline(side, 1)
+            .windows(2)
+            .map(|w| (w[0], w[1]))
+            .collect(),
+        FeatureKind::Curve => f
+            .outline(side, settings.curve_samples)
             .windows(2)
             .map(|w| (w[0], w[1]))
             .collect(),

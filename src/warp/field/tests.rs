@@ -290,3 +290,25 @@ proptest! {
         prop_assert!(w.map_reference(b1).distance(a1) < 0.05);
     }
 }
+
+#[test]
+fn a_closed_polyline_adds_the_line_from_its_last_point_back_to_its_first() {
+    let a = vec![v(0.0, 0.0), v(40.0, 0.0), v(20.0, 30.0)];
+    let b = vec![v(2.0, 1.0), v(44.0, 0.0), v(21.0, 35.0)];
+    let open = Feature::new(FeatureKind::Polyline, a.clone(), b.clone());
+    let closed = open.clone().closed(true);
+    let settings = FieldSettings::default();
+    let pairs =
+        |f: &Feature| line_pairs_toward(std::slice::from_ref(f), Side::A, 0.5.into(), &settings);
+    let (p_open, p_closed) = (pairs(&open), pairs(&closed));
+    assert_eq!(p_open.len(), 2);
+    assert_eq!(p_closed.len(), 3);
+    assert_eq!(p_closed[..2], p_open[..]);
+    // The closing pair runs from the last point to the first: on A exactly,
+    // halfway between A and B at t = 0.5.
+    assert_eq!(p_closed[2].src, (a[2], a[0]));
+    assert_eq!(
+        p_closed[2].dst,
+        (a[2].lerp(b[2], 0.5), a[0].lerp(b[0], 0.5))
+    );
+}
