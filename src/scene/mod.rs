@@ -1,6 +1,9 @@
 //! The scene: a `*.morph.json` document (docs/scene-format.md), parsed, validated and
 //! queried for the features and the progress at any frame.
 
+pub mod edit;
+#[cfg(test)]
+mod edit_tests;
 mod parse;
 mod range;
 mod scattered;

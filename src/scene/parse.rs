@@ -102,8 +102,32 @@ struct RawKeyframe {
 }
 
 impl Scene {
-    /// Parse and validate a scene document.
+    /// Parse and validate a scene document: [`Scene::read`], and a method
+    /// that needs features must have some.
     pub fn parse(text: &str) -> Result<Scene> {
+        let scene = Scene::read(text)?;
+        scene.check_has_features()?;
+        Ok(scene)
+    }
+
+    /// Refuses a scene whose method needs features when it has none.
+    pub fn check_has_features(&self) -> Result<()> {
+        let method = self.settings.method;
+        if method.needs_features() && !self.has_features() {
+            return Err(Error::scene(
+                "features",
+                format!(
+                    "method \"{}\" needs at least one feature; the scene has none",
+                    method.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Parse and validate a scene document that may lack features (a node
+    /// adds the lines of its own params to them).
+    pub fn read(text: &str) -> Result<Scene> {
         let raw: RawScene = serde_json::from_str(text).map_err(|e| {
             Error::scene(
                 format!("line {} column {}", e.line(), e.column()),
@@ -167,15 +191,6 @@ impl Scene {
             progress,
             extra,
         };
-        if method.needs_features() && !scene.has_features() {
-            return Err(Error::scene(
-                "features",
-                format!(
-                    "method \"{}\" needs at least one feature; the scene has none",
-                    method.name()
-                ),
-            ));
-        }
         Ok(scene)
     }
 }

@@ -39,7 +39,7 @@ fn load_scene(instance: &NodeState, settings: &Settings) -> Outcome<Option<Arc<S
             .map_err(|e| Failure::BadInput(format!("scene file {path}: {e}")))?,
         None => settings.scene_text.clone(),
     };
-    let scene = Scene::parse(&text).map_err(|e| match source {
+    let scene = Scene::read(&text).map_err(|e| match source {
         Some(path) => Failure::BadInput(format!("scene file {path}: {e}")),
         None => Failure::BadInput(format!("scene text: {e}")),
     })?;

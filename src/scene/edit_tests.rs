@@ -1,0 +1,183 @@
+use serde_json::Value;
+
+use super::edit::Document;
+use crate::features::{Feature, FeatureKind, Side};
+use crate::geom::Vec2;
+
+const STATIC: &str = r#"{
+  "format": "morphfx-scene", "version": 1, "method": "field",
+  "field": { "a": 0.001, "b": 2.0, "p": 0.5 },
+  "features": [
+    { "name": "nose", "type": "line", "a": [[410.1, 300], [412, 220]], "b": [[400, 310.7], [405, 215]] },
+    { "name": "lip", "type": "curve", "a": [[300, 200], [340, 180], [380, 200]], "b": [[300, 210], [340, 190], [380, 210]] }
+  ],
+  "progress": [[1001, 0.0], [1024, 1.0]],
+  "my_tool": { "zeta": 1, "alpha": 0.1 }
+}"#;
+
+const KEYED: &str = r#"{"keyframes": [
+  {"frame": 10, "features": [{"name": "eye", "type": "polyline", "a": [[0,0],[10,0],[10,10]], "b": [[0,0],[10,0],[10,10]],
+     "track": {"a": {"confidence": [1, 1, 1], "lost": [false, false, false]}}}]},
+  {"frame": 20, "features": [{"name": "eye", "type": "polyline", "a": [[10,0],[20,0],[20,10]], "b": [[0,0],[10,0],[10,10]]}]}
+]}"#;
+
+/// Every number in `v`, with its JSON path.
+fn numbers(v: &Value, path: String, out: &mut Vec<(String, f64)>) {
+    match v {
+        Value::Number(n) => out.push((path, n.as_f64().unwrap())),
+        Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                numbers(v, format!("{path}[{i}]"), out);
+            }
+        }
+        Value::Object(o) => {
+            for (k, v) in o {
+                numbers(v, format!("{path}.{k}"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The numbers that differ between two documents of the same layout.
+fn changed(before: &str, after: &str) -> Vec<(String, f64, f64)> {
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    numbers(
+        &serde_json::from_str(before).unwrap(),
+        String::new(),
+        &mut x,
+    );
+    numbers(&serde_json::from_str(after).unwrap(), String::new(), &mut y);
+    assert_eq!(x.len(), y.len(), "same layout");
+    x.into_iter()
+        .zip(y)
+        .filter(|(p, q)| p.1 != q.1 || p.0 != q.0)
+        .map(|(p, q)| (q.0, p.1, q.1))
+        .collect()
+}
+
+#[test]
+fn moving_one_point_changes_exactly_that_number_pair_and_keeps_key_order() {
+    let mut d = Document::parse(STATIC).unwrap();
+    d.set_point(5.0, 1, Side::B, 1, Vec2::new(345.25, 187.0))
+        .unwrap();
+    let text = d.text();
+    assert_eq!(
+        changed(STATIC, &text),
+        [
+            (".features[1].b[1][0]".into(), 340.0, 345.25),
+            (".features[1].b[1][1]".into(), 190.0, 187.0)
+        ]
+    );
+    // Keys keep the user's order (my_tool's zeta before alpha), and the
+    // text reads: one point per line, not one number.
+    assert!(text.find("zeta").unwrap() < text.find("alpha").unwrap());
+    assert!(
+        text.contains(r#""a": [[410.1, 300], [412, 220]]"#),
+        "{text}"
+    );
+    assert_eq!(d.scene().features[1].b[1], Vec2::new(345.25, 187.0));
+}
+
+#[test]
+fn an_edit_at_a_frame_between_keys_makes_a_key_there_from_the_interpolated_shape() {
+    let mut d = Document::parse(KEYED).unwrap();
+    d.set_point(15.0, 0, Side::A, 2, Vec2::new(30.0, 30.0))
+        .unwrap();
+    assert_eq!(d.keyed_frames(), [10.0, 15.0, 20.0]);
+    let k = &d.scene().keyframes[1].features[0];
+    assert_eq!(
+        k.a,
+        [
+            Vec2::new(5.0, 0.0),
+            Vec2::new(15.0, 0.0),
+            Vec2::new(30.0, 30.0)
+        ]
+    );
+    assert_eq!(k.b[2], Vec2::new(10.0, 10.0));
+    // The keys around it are untouched; the new key keeps the name and
+    // drops the tracker's flags (they were about frame 10's points).
+    assert_eq!(
+        d.scene().keyframes[0].features[0].a[2],
+        Vec2::new(10.0, 10.0)
+    );
+    let v: Value = serde_json::from_str(&d.text()).unwrap();
+    assert_eq!(v["keyframes"][1]["features"][0]["name"], "eye");
+    assert!(v["keyframes"][1]["features"][0].get("track").is_none());
+    assert!(v["keyframes"][0]["features"][0].get("track").is_some());
+    // An edit at an existing key edits that key.
+    d.set_point(20.0, 0, Side::B, 0, Vec2::new(1.0, 1.0))
+        .unwrap();
+    assert_eq!(d.keyed_frames(), [10.0, 15.0, 20.0]);
+    assert_eq!(d.scene().keyframes[2].features[0].b[0], Vec2::new(1.0, 1.0));
+}
+
+#[test]
+fn key_here_turns_a_static_scene_into_one_key_and_nothing_moves() {
+    let mut d = Document::parse(STATIC).unwrap();
+    let before = d.scene().features.clone();
+    d.key_here(1012.0).unwrap();
+    assert_eq!(d.keyed_frames(), [1012.0]);
+    assert_eq!(d.scene().features_at(0.0), before);
+    assert_eq!(d.scene().features_at(2000.0), before);
+    let v: Value = serde_json::from_str(&d.text()).unwrap();
+    assert!(v.get("features").is_none());
+}
+
+#[test]
+fn shapes_are_added_drawn_point_by_point_closed_and_deleted() {
+    let mut d = Document::parse("").unwrap();
+    let p = |x, y| Vec2::new(x, y);
+    let first = Feature::new(
+        FeatureKind::Polyline,
+        vec![p(0.0, 0.0), p(10.0, 0.0)],
+        vec![p(0.0, 0.0), p(10.0, 0.0)],
+    );
+    assert_eq!(d.add_feature(&first).unwrap(), 0);
+    d.append_point(0, p(10.0, 10.0)).unwrap();
+    d.set_closed(0, true).unwrap();
+    let f = &d.scene().features[0];
+    assert!(f.closed);
+    assert_eq!(f.a.len(), 3);
+    assert_eq!(f.b[2], p(10.0, 10.0));
+    let dot = Feature::point(p(50.0, 50.0), p(50.0, 50.0));
+    assert_eq!(d.add_feature(&dot).unwrap(), 1);
+    // A closed shape at its 3-point minimum goes whole with its point.
+    assert!(d.delete_point(0, 1).unwrap());
+    assert_eq!(d.scene().features.len(), 1);
+    assert_eq!(d.scene().features[0].kind, FeatureKind::Point);
+    d.delete_feature(0).unwrap();
+    assert!(d.scene().features.is_empty());
+    // A new document's text is itself a valid scene.
+    Document::parse(&d.text()).unwrap();
+}
+
+#[test]
+fn inserting_a_point_keeps_every_keys_shape() {
+    let mut d = Document::parse(KEYED).unwrap();
+    d.insert_point(0, 0, 0.25).unwrap();
+    let keys = &d.scene().keyframes;
+    assert_eq!(keys[0].features[0].a[1], Vec2::new(2.5, 0.0));
+    assert_eq!(keys[1].features[0].a[1], Vec2::new(12.5, 0.0));
+    assert_eq!(keys[1].features[0].b[1], Vec2::new(2.5, 0.0));
+    assert!(keys.iter().all(|k| k.features[0].a.len() == 4));
+    // A curve's new point lies on the curve: the span's parameter there.
+    let mut d = Document::parse(STATIC).unwrap();
+    let before = d.scene().features[1].sampled(Side::A, 4);
+    d.insert_point(1, 1, 0.5).unwrap();
+    assert_eq!(d.scene().features[1].a[2], before[6]);
+}
+
+#[test]
+fn an_edit_that_breaks_the_scene_is_refused_and_leaves_the_document() {
+    let mut d = Document::parse(STATIC).unwrap();
+    let text = d.text();
+    // Nose's end onto its start: a zero-length line.
+    let err = d
+        .set_point(0.0, 0, Side::A, 1, Vec2::new(410.1, 300.0))
+        .unwrap_err();
+    assert!(err.to_string().contains("zero length"), "{err}");
+    assert_eq!(d.text(), text);
+    assert!(Document::parse("{ not json").is_err());
+    assert!(d.set_point(0.0, 7, Side::A, 0, Vec2::ZERO).is_err());
+}
