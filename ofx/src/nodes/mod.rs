@@ -199,6 +199,15 @@ fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) 
         track::track_lines(node, effect, time, 1)
     } else if name == params::TRACK_BACKWARD.name() {
         track::track_lines(node, effect, time, -1)
+    } else if name == params::FINISH_SHAPE.name() {
+        overlay::finish_shape(node);
+        Ok(())
+    } else if name == params::DELETE_SHAPE.name() {
+        overlay::delete_shape(node, effect, time)
+    } else if name == params::KEY_SHAPES.name() {
+        overlay::shapes::key_here(node, effect, time)
+    } else if name == params::COPY_SCENE.name() {
+        overlay::shapes::copy_scene(node, effect, time)
     } else if name == params::LINE_COUNT.name() {
         lines::hide_unused(node.kind, node.params(), time);
         Ok(())

@@ -196,7 +196,7 @@ impl EffectHandle {
     /// Sets the node's persistent error (message suite v2), which stays on
     /// the node until [`EffectHandle::clear_persistent`]. False when the host has
     /// no v2 suite (the caller then posts a transient message).
-    pub(super) fn persistent_error(&self, id: &CStr, text: &str) -> bool {
+    pub(crate) fn persistent_error(&self, id: &CStr, text: &str) -> bool {
         let Some(f) = self.suites.message_v2.and_then(|s| s.setPersistentMessage) else {
             return false;
         };
@@ -216,7 +216,7 @@ impl EffectHandle {
     }
 
     /// Clears the persistent message set by [`EffectHandle::persistent_error`].
-    pub(super) fn clear_persistent(&self) {
+    pub(crate) fn clear_persistent(&self) {
         if let Some(f) = self
             .suites
             .message_v2

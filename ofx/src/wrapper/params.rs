@@ -465,6 +465,19 @@ impl Params {
         check(unsafe { f(h, v as c_int) }, &format!("setting {id}"))
     }
 
+    /// Sets a String param's value. A string with a NUL in it cannot cross
+    /// the C ABI and is refused.
+    pub fn set_string(&self, id: &str, v: &str) -> Outcome {
+        let h = self.typed(id, Values::OneString)?;
+        let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
+        let v = CString::new(v)
+            .map_err(|_| Failure::BadInput(format!("setting {id}: the text holds a NUL")))?;
+        // SAFETY: `h` is a String param (checked by `typed`), which takes
+        // one `char*` vararg; the host copies the NUL-terminated string,
+        // which lives until the call returns.
+        check(unsafe { f(h, v.as_ptr()) }, &format!("setting {id}"))
+    }
+
     /// Moves a point the user is editing: keyed at `time` when the param
     /// already animates (other keys stay), set outright when it has none,
     /// or when the host cannot count keys (the OpenFX reference host

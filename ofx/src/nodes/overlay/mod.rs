@@ -1,30 +1,36 @@
-//! The viewer overlay of both nodes: the line slots drawn with their
-//! numbers, directions and in-between lines, and edited with the pen
-//! (drag an end, drag a line by its middle, drag in empty space for a new
-//! line). The wrapper turns interact actions into these calls.
+//! The viewer overlay of both nodes: every feature drawn (line slots,
+//! Scene Text's shapes, Scene File's features dimmer) with directions,
+//! names, connectors and in-between shapes, and edited with the pen: drag
+//! a point or a whole feature, draw lines, points, polylines and curves,
+//! insert and delete points. The wrapper turns interact actions into these
+//! calls; `pen` holds what the pen does, `shapes` the Scene Text edits.
 
 mod hit;
+mod outline;
 pub mod paint;
+mod pen;
+pub mod shapes;
 
 use std::sync::Mutex;
 
-use morphfx::features::{Feature, Side, Tween};
+use morphfx::features::{Feature, Side};
 use morphfx::geom::Vec2;
-use morphfx::warp::field::line_pairs_toward;
+use morphfx::scene::edit::Document;
 
 use crate::wrapper::keys;
 use crate::wrapper::paint::Painter;
 pub use hit::{Handle, Part};
+pub use outline::{Outline, Owner};
 use paint::Frame;
 
-use super::lines::{self, end_id, slot_lines, SlotLine};
+use super::lines::slot_lines;
 use super::params::{
-    slot_ids, EditSides, Reader, Settings, Show, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT, OVERLAY_SHOW,
+    slot_ids, EditSides, Reader, Settings, Show, DRAW_TOOL, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT,
+    OVERLAY_SHOW, SCENE_FILE, SCENE_TEXT,
 };
-use super::render::warp_inputs;
-use super::{Node, NodeKind, NodeState};
+use super::render::{load_scene, warp_inputs};
+use super::{Node, NodeState};
 use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::params::Params;
 use crate::wrapper::plugin::{DrawArgs, Overlay, Pen};
 use crate::wrapper::{Outcome, Reply};
 
@@ -33,6 +39,12 @@ use crate::wrapper::{Outcome, Reply};
 pub struct State {
     hover: Option<Handle>,
     drag: Option<Drag>,
+    /// The polyline or curve being drawn, click by click.
+    building: Option<Building>,
+    /// The Scene Text shape last drawn or grabbed (Delete Shape's target).
+    selected: Option<usize>,
+    /// An edit was refused and its message is on the node.
+    refused: bool,
     shift: bool,
     ctrl: bool,
     /// Canonical units per screen pixel as the last OpenGL draw measured
@@ -40,26 +52,49 @@ pub struct State {
     measured_pixel: Option<(f64, f64)>,
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 enum Drag {
-    /// Moving `handle`; the grabbed line's ends and the pen when it began.
-    Move {
-        handle: Handle,
+    /// Moving part `part` of slot `slot`'s line on `side`; the line's ends
+    /// and the pen when it began.
+    Slot {
+        slot: usize,
+        side: Side,
+        part: Part,
         from: Vec2,
         ends: [Vec2; 2],
     },
     /// Drawing a new line into `slot` from `start`.
-    New {
+    NewLine {
         slot: usize,
         start: Vec2,
         count_before: i32,
     },
+    /// Moving Scene Text's feature `feature` on `side`: one point, or all of
+    /// them by the pen's motion. Each event edits `before` afresh, so only
+    /// the grabbed numbers change whatever the path.
+    Shape {
+        feature: usize,
+        side: Side,
+        point: Option<usize>,
+        from: Vec2,
+        points: Vec<Vec2>,
+        before: Box<Document>,
+    },
+}
+
+/// A polyline or curve being drawn.
+#[derive(Debug, Clone)]
+struct Building {
+    kind: morphfx::features::FeatureKind,
+    points: Vec<Vec2>,
+    /// Its index in Scene Text once it has two points (and is written).
+    feature: Option<usize>,
 }
 
 /// Shortest new line kept, in screen pixels: a click is not a line.
 const MIN_NEW_LINE_PX: f64 = 3.0;
 
-/// The overlay both nodes share: the line slots, drawn and edited.
+/// The overlay both nodes share.
 pub struct SlotOverlay;
 
 impl<N: Node> Overlay<N> for SlotOverlay {
@@ -74,22 +109,22 @@ impl<N: Node> Overlay<N> for SlotOverlay {
     ) -> Outcome<Reply> {
         draw(node.state(), args, painter)
     }
-    fn pen_down(node: &N, _: &EffectHandle, pen: Pen) -> Outcome<Reply> {
-        pen_down(node.state(), pen)
+    fn pen_down(node: &N, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+        pen::down(node.state(), effect, pen)
     }
     fn pen_motion(
         node: &N,
-        _: &EffectHandle,
+        effect: &EffectHandle,
         pen: Pen,
         redraw: &mut dyn FnMut(),
     ) -> Outcome<Reply> {
-        pen_motion(node.state(), pen, redraw)
+        pen::motion(node.state(), effect, pen, redraw)
     }
-    fn pen_up(node: &N, _: &EffectHandle, pen: Pen) -> Outcome<Reply> {
-        pen_up(node.state(), pen)
+    fn pen_up(node: &N, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+        pen::up(node.state(), effect, pen)
     }
-    fn key_down(node: &N, _: &EffectHandle, key: i32, time: f64) -> Outcome<Reply> {
-        key_down(node.state(), key, time)
+    fn key_down(node: &N, effect: &EffectHandle, key: i32, time: f64) -> Outcome<Reply> {
+        pen::key_down(node.state(), effect, key, time)
     }
     fn key_up(node: &N, _: &EffectHandle, key: i32) -> Outcome<Reply> {
         key_up(node.state(), key)
@@ -101,11 +136,17 @@ impl<N: Node> Overlay<N> for SlotOverlay {
 
 /// The params every overlay redraw depends on (the interact is slaved to them).
 fn slave_params() -> Vec<String> {
-    let mut ids = vec![
-        LINE_COUNT.name().to_owned(),
-        OVERLAY_SHOW.name().to_owned(),
-        OVERLAY_EDIT.name().to_owned(),
-    ];
+    let mut ids: Vec<String> = [
+        LINE_COUNT.name(),
+        OVERLAY_SHOW.name(),
+        OVERLAY_EDIT.name(),
+        DRAW_TOOL.name(),
+        SCENE_TEXT.name(),
+        SCENE_FILE.name(),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     for k in 1..=LINE_SLOTS {
         ids.extend(slot_ids(k).names());
     }
@@ -116,6 +157,55 @@ fn lock(state: &Mutex<State>) -> std::sync::MutexGuard<'_, State> {
     state.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Every feature of the node at `time`, with the progress and the frames
+/// Scene Text's shapes are keyed at. A scene that does not parse is drawn
+/// as nothing (the slots still are).
+struct View {
+    outlines: Vec<Outline>,
+    t: f64,
+    keys: Vec<f64>,
+    settings: Settings,
+}
+
+fn view(instance: &NodeState, time: f64) -> View {
+    let settings = Settings::read(instance.params(), time, instance.kind);
+    let slots = slot_lines(&Reader::new(instance.params(), instance.kind, time));
+    let from_file = !settings.scene_file.trim().is_empty();
+    let mut outlines = Vec::new();
+    let mut t = settings.progress;
+    if let Ok(inputs) = warp_inputs(instance, &settings, time) {
+        let n = inputs.features.len() - settings.lines.len();
+        let owner = |i| {
+            if from_file {
+                Owner::File(i)
+            } else {
+                Owner::Shape(i)
+            }
+        };
+        outlines.extend(
+            inputs.features[..n]
+                .iter()
+                .enumerate()
+                .map(|(i, f)| Outline {
+                    owner: owner(i),
+                    feature: f.clone(),
+                }),
+        );
+        t = inputs.t;
+    }
+    let keys = match load_scene(instance, &settings) {
+        Ok(Some(scene)) if !from_file => scene.keyframes.iter().map(|k| k.frame).collect(),
+        _ => Vec::new(),
+    };
+    outlines.extend(slots.iter().map(Outline::slot));
+    View {
+        outlines,
+        t,
+        keys,
+        settings,
+    }
+}
+
 /// Draws the overlay (returns at once when Show Lines is off). A pixel
 /// scale measured from the OpenGL projection is kept for the pen events
 /// that follow (they carry only the host's figure).
@@ -124,49 +214,35 @@ fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Out
     if args.measured {
         lock(&instance.overlay).measured_pixel = Some(pixel);
     }
-    let params = instance.params();
-    let show: Show = Reader::new(params, kind, time).choice(&OVERLAY_SHOW);
+    let show: Show = Reader::new(instance.params(), kind, time).choice(&OVERLAY_SHOW);
     if show == Show::Off {
         return Ok(Reply::Done);
     }
-    let settings = Settings::read(params, time, kind);
-    let slots = slot_lines(&Reader::new(params, kind, time));
-    // A scene that does not parse still leaves the slots to draw.
-    let (scene, t) = match warp_inputs(instance, &settings, time) {
-        Ok(inputs) => {
-            let n = inputs.features.len() - settings.lines.len();
-            (inputs.features[..n].to_vec(), inputs.t)
-        }
-        Err(_) => (Vec::new(), settings.progress),
+    let v = view(instance, time);
+    let field = &v.settings.warp.field;
+    let between: Vec<Vec<Vec2>> = v
+        .outlines
+        .iter()
+        .map(|o| outline::in_between(o, v.t, field))
+        .collect();
+    let (hover, building) = {
+        let state = lock(&instance.overlay);
+        let building = state.building.as_ref().map(|b| b.points.clone());
+        (state.hover, building.unwrap_or_default())
     };
-    let between: Vec<[Vec2; 2]> = slots.iter().map(|l| in_between(l, t, &settings)).collect();
-    let hover = lock(&instance.overlay).hover;
     paint::paint(
         painter,
         &Frame {
-            slots: &slots,
+            outlines: &v.outlines,
             between: &between,
-            scene: &scene,
             show,
             hover,
             pixel,
+            keys: (&v.keys, time),
+            building: &building,
         },
     );
     Ok(Reply::Done)
-}
-
-/// The slot's line at progress `t` as the field warp places it (line
-/// interpolation included).
-fn in_between(l: &SlotLine, t: f64, settings: &Settings) -> [Vec2; 2] {
-    if l.a[0] == l.a[1] || l.b[0] == l.b[1] {
-        return [0, 1].map(|k| l.a[k].lerp(l.b[k], t));
-    }
-    let f = [Feature::line(l.a, l.b)];
-    let pairs = line_pairs_toward(&f, Side::A, Tween::uniform(t), &settings.warp.field);
-    match pairs.first() {
-        Some(pair) => [pair.dst.0, pair.dst.1],
-        None => [0, 1].map(|k| l.a[k].lerp(l.b[k], t)),
-    }
 }
 
 /// The sides the pen may grab: the Edit Lines param, narrowed by Shift (A)
@@ -189,169 +265,9 @@ fn editable(edit: EditSides, show: Show, state: &State) -> Vec<Side> {
     wanted.iter().copied().filter(shown).collect()
 }
 
-/// What the pen can reach at `pen.time`: the slots and the grabbable sides.
-fn reach(kind: NodeKind, params: &Params, state: &State, time: f64) -> (Vec<SlotLine>, Vec<Side>) {
-    let r = Reader::new(params, kind, time);
-    let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), state);
-    (slot_lines(&r), sides)
-}
-
 /// The pen's scale: the host's, unless an OpenGL draw measured another.
 fn pixel_of(state: &State, pen: &Pen) -> (f64, f64) {
     state.measured_pixel.unwrap_or(pen.pixel)
-}
-
-/// Pen down: grabs the handle under the pen, or starts a new line in the
-/// next free slot. One edit block (one undo step) until pen up.
-fn pen_down(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
-    let kind = instance.kind;
-    let params = instance.params();
-    let drag = {
-        let state = lock(&instance.overlay);
-        let (slots, sides) = reach(kind, params, &state, pen.time);
-        if sides.is_empty() {
-            return Ok(Reply::Default);
-        }
-        match hit::hit(&slots, pen.at, pixel_of(&state, &pen), &sides) {
-            Some(handle) => {
-                let line = slots.iter().find(|l| l.slot == handle.slot);
-                let ends = line.map_or([pen.at; 2], |l| l.side(handle.side));
-                Drag::Move {
-                    handle,
-                    from: pen.at,
-                    ends,
-                }
-            }
-            None => {
-                let count = Reader::new(params, kind, pen.time).int(&LINE_COUNT);
-                if count as usize >= LINE_SLOTS {
-                    return Ok(Reply::Default);
-                }
-                Drag::New {
-                    slot: count as usize + 1,
-                    start: pen.at,
-                    count_before: count,
-                }
-            }
-        }
-    };
-    match drag {
-        Drag::Move { handle, .. } => params.begin_edit(&format!("Move Line {}", handle.slot))?,
-        Drag::New { slot, .. } => {
-            params.begin_edit(&format!("New Line {slot}"))?;
-            params.set_int(LINE_COUNT.name(), slot as i32)?;
-            params.set_int(slot_ids(slot).enable.name(), 1)?;
-        }
-    }
-    lock(&instance.overlay).drag = Some(drag);
-    write_drag(params, drag, pen)?;
-    Ok(Reply::Done)
-}
-
-/// Writes where the drag puts its params for the pen at `pen`.
-fn write_drag(params: &Params, drag: Drag, pen: Pen) -> Outcome {
-    let xy = |p: Vec2| (p.x, p.y);
-    match drag {
-        Drag::Move { handle, from, ends } => {
-            let id = |end| end_id(handle.slot, handle.side, end);
-            match handle.part {
-                Part::Start => params.move_point(id(0).name(), pen.time, xy(pen.at)),
-                Part::End => params.move_point(id(1).name(), pen.time, xy(pen.at)),
-                Part::Middle => {
-                    let d = pen.at - from;
-                    params.move_point(id(0).name(), pen.time, xy(ends[0] + d))?;
-                    params.move_point(id(1).name(), pen.time, xy(ends[1] + d))
-                }
-            }
-        }
-        Drag::New { slot, start, .. } => {
-            for side in [Side::A, Side::B] {
-                params.move_point(end_id(slot, side, 0).name(), pen.time, xy(start))?;
-                params.move_point(end_id(slot, side, 1).name(), pen.time, xy(pen.at))?;
-            }
-            Ok(())
-        }
-    }
-}
-
-/// Pen motion: moves what is dragged; otherwise tracks the handle under the
-/// pen and asks for a redraw when it changes (and leaves the event to the
-/// host).
-fn pen_motion(instance: &NodeState, pen: Pen, redraw: &mut dyn FnMut()) -> Outcome<Reply> {
-    let kind = instance.kind;
-    let params = instance.params();
-    let mut state = lock(&instance.overlay);
-    if let Some(drag) = state.drag {
-        drop(state);
-        write_drag(params, drag, pen)?;
-        return Ok(Reply::Done);
-    }
-    let (slots, sides) = reach(kind, params, &state, pen.time);
-    let hover = hit::hit(&slots, pen.at, pixel_of(&state, &pen), &sides);
-    if hover != state.hover {
-        state.hover = hover;
-        drop(state);
-        redraw();
-    }
-    Ok(Reply::Default)
-}
-
-/// Pen up: the drag's last write, and its edit block closed. A click that
-/// drew no line takes its slot back.
-fn pen_up(instance: &NodeState, pen: Pen) -> Outcome<Reply> {
-    let kind = instance.kind;
-    let params = instance.params();
-    let (drag, pixel) = {
-        let mut state = lock(&instance.overlay);
-        (state.drag.take(), pixel_of(&state, &pen))
-    };
-    let Some(drag) = drag else {
-        return Ok(Reply::Default);
-    };
-    let written = match drag {
-        Drag::New {
-            start,
-            count_before,
-            ..
-        } if screen_length(start, pen.at, pixel) < MIN_NEW_LINE_PX => {
-            params.set_int(LINE_COUNT.name(), count_before)
-        }
-        _ => write_drag(params, drag, pen),
-    };
-    let closed = params.end_edit();
-    written?;
-    closed?;
-    if matches!(drag, Drag::New { .. }) {
-        lines::hide_unused(kind, params, pen.time);
-    }
-    Ok(Reply::Done)
-}
-
-fn screen_length(p: Vec2, q: Vec2, pixel: (f64, f64)) -> f64 {
-    Vec2::new((q.x - p.x) / pixel.0, (q.y - p.y) / pixel.1).length()
-}
-
-/// Key down: modifiers narrow what the pen grabs (and stay the host's
-/// too); Delete or BackSpace clears the hovered line.
-fn key_down(instance: &NodeState, sym: i32, time: f64) -> Outcome<Reply> {
-    let hovered = {
-        let mut state = lock(&instance.overlay);
-        if keys::SHIFT.contains(&sym) {
-            state.shift = true;
-        }
-        if keys::CONTROL.contains(&sym) {
-            state.ctrl = true;
-        }
-        if !keys::DELETE.contains(&sym) || state.drag.is_some() {
-            return Ok(Reply::Default);
-        }
-        state.hover.take()
-    };
-    let Some(handle) = hovered else {
-        return Ok(Reply::Default);
-    };
-    lines::clear(instance.kind, instance.params(), handle.slot, time)?;
-    Ok(Reply::Done)
 }
 
 /// Key up: releases a modifier.
@@ -374,4 +290,41 @@ fn lose_focus(instance: &NodeState) -> Outcome<Reply> {
     state.ctrl = false;
     state.hover = None;
     Ok(Reply::Default)
+}
+
+/// The Finish Shape button: the polyline or curve being drawn ends open.
+pub fn finish_shape(instance: &NodeState) {
+    let mut state = lock(&instance.overlay);
+    if let Some(b) = state.building.take() {
+        state.selected = b.feature.or(state.selected);
+    }
+}
+
+/// The Delete Shape button: the shape last drawn or grabbed leaves Scene Text.
+pub fn delete_shape(instance: &NodeState, effect: &EffectHandle, time: f64) -> Outcome {
+    let selected = {
+        let mut state = lock(&instance.overlay);
+        state.building = None;
+        state.hover = None;
+        state.selected.take()
+    };
+    let Some(feature) = selected else {
+        effect.warning(
+            c"net.morphfx.overlay.select",
+            "Delete Shape: grab a shape in the viewer first (the last one drawn or grabbed is deleted)",
+        );
+        return Ok(());
+    };
+    let result = shapes::document(instance, time).and_then(|mut doc| {
+        doc.delete_feature(feature).map_err(shapes::refused)?;
+        instance
+            .params()
+            .edit_block("Delete Shape", || shapes::write(instance, &doc))
+    });
+    shapes::settle(instance, effect, result)
+}
+
+/// A new point feature at `at` on both sides.
+fn point_feature(at: Vec2) -> Feature {
+    Feature::point(at, at)
 }

@@ -1,42 +1,50 @@
 //! What the overlay draws, as calls on a [`Painter`]: pure, so it is tested
 //! without a host, and the same for the Draw suite and OpenGL.
 
-use morphfx::features::{Feature, Side};
+use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
 
 use super::hit::{Handle, Part};
-use crate::nodes::lines::SlotLine;
+use super::outline::{per_span, Outline};
 use crate::nodes::params::Show;
 use crate::wrapper::paint::{Painter, Stipple, LABEL_PX};
 
 /// Everything one draw shows.
 pub struct Frame<'a> {
-    /// The slots' lines at the draw's time.
-    pub slots: &'a [SlotLine],
-    /// The slots' in-between lines at the progress, in the same order.
-    pub between: &'a [[Vec2; 2]],
-    /// Features of the scene file or text: drawn dimmer, not editable.
-    pub scene: &'a [Feature],
+    /// Every feature at the draw's time: slots, Scene Text's shapes, Scene
+    /// File's features (drawn dimmer).
+    pub outlines: &'a [Outline],
+    /// Each outline's in-between chain at the progress, in the same order.
+    pub between: &'a [Vec<Vec2>],
     /// What to show.
     pub show: Show,
     /// The handle under the pen.
     pub hover: Option<Handle>,
     /// Canonical units per screen pixel, x and y.
     pub pixel: (f64, f64),
+    /// The frames the scene's shapes are keyed at, and the draw's time.
+    pub keys: (&'a [f64], f64),
+    /// The control points of a polyline or curve being drawn.
+    pub building: &'a [Vec2],
 }
 
-/// A's lines.
+/// A's features.
 pub const A_COLOUR: [f32; 3] = [1.0, 0.55, 0.1];
-/// B's lines.
+/// B's features.
 pub const B_COLOUR: [f32; 3] = [0.25, 0.8, 1.0];
 const BETWEEN_COLOUR: [f32; 3] = [0.95, 0.95, 0.95];
 const CONNECTOR_COLOUR: [f32; 3] = [0.75, 0.75, 0.75];
 const SHADOW: [f32; 4] = [0.0, 0.0, 0.0, 0.8];
+/// Scene File's features: read-only, so drawn fainter.
+const FILE_ALPHA: f32 = 0.45;
 
 /// Arrowhead and label sizes, in screen pixels.
 const ARROW_PX: f64 = 10.0;
 const LABEL_GAP_PX: f64 = 6.0;
 const HANDLE_PX: f64 = 4.0;
+/// Control point marks of shapes, half a side, screen pixels.
+const POINT_PX: f64 = 2.5;
+
 /// Draws `frame`: everything twice, a dark shadow one pixel down and right,
 /// then in colour, so it reads on any plate.
 pub fn paint(p: &mut dyn Painter, frame: &Frame<'_>) {
@@ -56,8 +64,11 @@ pub fn paint(p: &mut dyn Painter, frame: &Frame<'_>) {
             shadow,
             pixel: frame.pixel,
         };
-        pen.scene(frame);
-        pen.slots(frame);
+        pen.connectors(frame);
+        pen.between(frame);
+        pen.features(frame);
+        pen.building(frame.building);
+        pen.keys(frame);
     }
 }
 
@@ -96,6 +107,11 @@ impl Pen<'_> {
     /// The line `p → q` with an arrowhead at `q`.
     fn arrow(&mut self, [p, q]: [Vec2; 2]) {
         self.segment([p, q]);
+        self.head([p, q]);
+    }
+
+    /// An arrowhead at `q` pointing from `p`.
+    fn head(&mut self, [p, q]: [Vec2; 2]) {
         // The head's direction in screen pixels, so it keeps its shape at
         // any zoom and pixel aspect.
         let d = Vec2::new((q.x - p.x) / self.pixel.0, (q.y - p.y) / self.pixel.1);
@@ -125,85 +141,165 @@ impl Pen<'_> {
         self.painter.text(at, text);
     }
 
-    fn scene(&mut self, frame: &Frame<'_>) {
+    /// Thin connectors from A's control points to B's.
+    fn connectors(&mut self, frame: &Frame<'_>) {
+        if frame.show != Show::Both {
+            return;
+        }
         self.painter.stipple(Stipple::Solid);
         self.painter.width(1.0);
+        self.colour(CONNECTOR_COLOUR, 0.5);
+        let pts: Vec<Vec2> = frame
+            .outlines
+            .iter()
+            .filter(|o| o.editable())
+            .flat_map(|o| o.feature.a.iter().zip(&o.feature.b))
+            .flat_map(|(a, b)| [*a, *b])
+            .map(|p| self.at(p))
+            .collect();
+        if !pts.is_empty() {
+            self.painter.lines(&pts);
+        }
+    }
+
+    /// The in-between shapes at the progress, dashed.
+    fn between(&mut self, frame: &Frame<'_>) {
+        if !matches!(frame.show, Show::Both | Show::Between) {
+            return;
+        }
+        self.painter.stipple(Stipple::Dash);
+        self.painter.width(1.0);
+        self.colour(BETWEEN_COLOUR, 0.9);
+        for (o, chain) in frame.outlines.iter().zip(frame.between) {
+            self.shape(o, chain);
+        }
+    }
+
+    /// Every feature on each side shown: chain, direction mark, label, and
+    /// for shapes their control points; the hovered one heavier.
+    fn features(&mut self, frame: &Frame<'_>) {
+        self.painter.stipple(Stipple::Solid);
+        let mut marks = Vec::new();
         for (side, colour) in sides(frame.show) {
-            self.colour(colour, 0.55);
-            for f in frame.scene {
-                let pts: Vec<Vec2> = f.sampled(side, 8).iter().map(|p| self.at(*p)).collect();
-                match pts.len() {
-                    0 => {}
-                    1 => {
-                        // A point feature: a small cross.
-                        let (h, v) = (self.screen(HANDLE_PX, 0.0), self.screen(0.0, HANDLE_PX));
-                        let c = pts[0];
-                        self.painter.lines(&[c - h, c + h, c - v, c + v]);
-                    }
-                    _ => self.painter.strip(&pts),
+            for o in frame.outlines {
+                let hovered = frame.hover.filter(|h| h.owner == o.owner && h.side == side);
+                let width = match (o.editable(), hovered) {
+                    (false, _) => 1.0,
+                    (true, Some(_)) => 3.0,
+                    (true, None) => 1.5,
+                };
+                self.painter.width(width);
+                self.colour(colour, if o.editable() { 1.0 } else { FILE_ALPHA });
+                let chain = o.chain(side);
+                self.shape(o, &chain);
+                let points = o.feature.points(side);
+                self.label(points[0], side, &o.label());
+                if let Some(h) = hovered {
+                    self.handle(points, h.part);
                 }
+                if o.editable() && o.feature.kind != FeatureKind::Line {
+                    marks.extend(points.iter().flat_map(|p| self.square(*p, POINT_PX)));
+                }
+            }
+            if !marks.is_empty() {
+                self.painter.width(1.0);
+                self.painter.lines(&marks);
+                marks.clear();
             }
         }
     }
 
-    fn slots(&mut self, frame: &Frame<'_>) {
-        if matches!(frame.show, Show::Both) {
-            // Thin connectors from A's ends to B's.
-            self.painter.stipple(Stipple::Solid);
-            self.painter.width(1.0);
-            self.colour(CONNECTOR_COLOUR, 0.5);
-            let pts: Vec<Vec2> = frame
-                .slots
-                .iter()
-                .flat_map(|l| [l.a[0], l.b[0], l.a[1], l.b[1]])
-                .map(|p| self.at(p))
-                .collect();
-            if !pts.is_empty() {
+    /// One feature's chain with its direction mark: an arrowhead at the end
+    /// of an open chain, at the end of the first span of a closed one; a
+    /// point is a cross.
+    fn shape(&mut self, o: &Outline, chain: &[Vec2]) {
+        match chain {
+            [] => {}
+            [c] => {
+                let (h, v) = (self.screen(HANDLE_PX, 0.0), self.screen(0.0, HANDLE_PX));
+                let pts = [*c - h, *c + h, *c - v, *c + v].map(|p| self.at(p));
                 self.painter.lines(&pts);
             }
-        }
-        if matches!(frame.show, Show::Both | Show::Between) {
-            self.painter.stipple(Stipple::Dash);
-            self.painter.width(1.0);
-            self.colour(BETWEEN_COLOUR, 0.9);
-            for line in frame.between {
-                self.arrow(*line);
-            }
-        }
-        self.painter.stipple(Stipple::Solid);
-        for (side, colour) in sides(frame.show) {
-            for l in frame.slots {
-                let hovered = frame.hover.filter(|h| h.slot == l.slot && h.side == side);
-                self.painter
-                    .width(if hovered.is_some() { 3.0 } else { 1.5 });
-                self.colour(colour, 1.0);
-                let line = l.side(side);
-                self.arrow(line);
-                self.label(line[0], side, &l.slot.to_string());
-                if let Some(h) = hovered {
-                    self.handle(line, h.part);
-                }
+            [p, q] => self.arrow([*p, *q]),
+            _ => {
+                let pts: Vec<Vec2> = chain.iter().map(|p| self.at(*p)).collect();
+                self.painter.strip(&pts);
+                let tip = if o.feature.closed {
+                    per_span(o.feature.kind).min(chain.len() - 1)
+                } else {
+                    chain.len() - 1
+                };
+                self.head([chain[tip - 1], chain[tip]]);
             }
         }
     }
 
-    /// A square around the hovered end (none for a whole-line grab).
-    fn handle(&mut self, line: [Vec2; 2], part: Part) {
-        let c = match part {
-            Part::Start => line[0],
-            Part::End => line[1],
-            Part::Middle => return,
+    /// The control points of a polyline or curve being drawn, joined, the
+    /// first one marked larger (a click there closes the shape).
+    fn building(&mut self, points: &[Vec2]) {
+        let Some(first) = points.first() else {
+            return;
         };
-        let (dx, dy) = (self.screen(HANDLE_PX, 0.0), self.screen(0.0, HANDLE_PX));
-        let pts = [
-            c - dx - dy,
-            c + dx - dy,
-            c + dx + dy,
-            c - dx + dy,
-            c - dx - dy,
-        ];
-        let pts = pts.map(|p| self.at(p));
-        self.painter.strip(&pts);
+        self.painter.stipple(Stipple::Solid);
+        self.painter.width(1.5);
+        self.colour(A_COLOUR, 1.0);
+        if points.len() > 1 {
+            let pts: Vec<Vec2> = points.iter().map(|p| self.at(*p)).collect();
+            self.painter.strip(&pts);
+        }
+        let mut marks = self.square(*first, HANDLE_PX * 1.5).to_vec();
+        marks.extend(points.iter().flat_map(|p| self.square(*p, POINT_PX)));
+        self.painter.lines(&marks);
+    }
+
+    /// "keys 10 15 [20]": the frames Scene Text's shapes are keyed at (the
+    /// draw's frame bracketed when it is one), below the lowest shape.
+    fn keys(&mut self, frame: &Frame<'_>) {
+        let (keys, time) = frame.keys;
+        if keys.is_empty() {
+            return;
+        }
+        let shapes = frame
+            .outlines
+            .iter()
+            .filter(|o| matches!(o.owner, super::outline::Owner::Shape(_)));
+        let corner = shapes
+            .flat_map(|o| o.feature.a.iter().chain(&o.feature.b))
+            .fold(None, |m: Option<Vec2>, p| {
+                Some(m.map_or(*p, |m| Vec2::new(m.x.min(p.x), m.y.min(p.y))))
+            });
+        let Some(corner) = corner else { return };
+        let list: Vec<String> = keys
+            .iter()
+            .map(|k| {
+                if (k - time).abs() < 1e-6 {
+                    format!("[{k}]")
+                } else {
+                    k.to_string()
+                }
+            })
+            .collect();
+        self.colour(BETWEEN_COLOUR, 1.0);
+        let at = self.at(corner - self.screen(0.0, 3.0 * LABEL_PX));
+        self.painter.text(at, &format!("keys {}", list.join(" ")));
+    }
+
+    /// A square of half-side `half_px` screen pixels around `c`, as four
+    /// segments (eight points), so many go in one draw call.
+    fn square(&self, c: Vec2, half_px: f64) -> [Vec2; 8] {
+        let (dx, dy) = (self.screen(half_px, 0.0), self.screen(0.0, half_px));
+        let corners = [c - dx - dy, c + dx - dy, c + dx + dy, c - dx + dy];
+        let k = corners.map(|p| self.at(p));
+        [k[0], k[1], k[1], k[2], k[2], k[3], k[3], k[0]]
+    }
+
+    /// A square around the hovered control point (none for a body grab).
+    fn handle(&mut self, points: &[Vec2], part: Part) {
+        let Part::Point(i) = part else { return };
+        if let Some(c) = points.get(i) {
+            let marks = self.square(*c, HANDLE_PX);
+            self.painter.lines(&marks);
+        }
     }
 }
 

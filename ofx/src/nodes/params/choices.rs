@@ -57,6 +57,36 @@ impl Choice for EditSides {
     }
 }
 
+/// What a pen down in empty space in the viewer draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DrawTool {
+    /// A drag draws a line into the next free slot.
+    Line,
+    /// A click adds a point feature to Scene Text.
+    Point,
+    /// Clicks add the control points of a polyline.
+    Polyline,
+    /// Clicks add the control points of a Catmull-Rom curve.
+    Curve,
+}
+
+impl Choice for DrawTool {
+    const ALL: &'static [Self] = &[
+        DrawTool::Line,
+        DrawTool::Point,
+        DrawTool::Polyline,
+        DrawTool::Curve,
+    ];
+    fn name(self) -> &'static str {
+        match self {
+            DrawTool::Line => "line",
+            DrawTool::Point => "point",
+            DrawTool::Polyline => "polyline",
+            DrawTool::Curve => "curve",
+        }
+    }
+}
+
 /// The methods a node offers, in choice order (hosts save the index: only
 /// ever append). Auto finds its warp from both pictures, so the Warp node,
 /// which has one, stops before it; auto is last, so no index moves.

@@ -9,7 +9,7 @@ use morphfx::image::{EdgeMode, Filter};
 use morphfx::warp::field::LineInterpolation;
 use morphfx::warp::mesh::Pass;
 
-use super::choices::{Affects, EditSides, EvaluationMode, Show};
+use super::choices::{Affects, DrawTool, EditSides, EvaluationMode, Show};
 
 /// A param's id, typed with the kind of value it holds (`Double`, `Int`,
 /// `Bool`, `Text`, `Point`, `Choose<C>`, `Indexed`, `Button`).
@@ -100,6 +100,11 @@ pub const TRACK_FORWARD: Id<Button> = Id::new("track_forward");
 pub const TRACK_BACKWARD: Id<Button> = Id::new("track_backward");
 pub const OVERLAY_SHOW: Id<Choose<Show>> = Id::new("overlay_show");
 pub const OVERLAY_EDIT: Id<Choose<EditSides>> = Id::new("overlay_edit");
+pub const DRAW_TOOL: Id<Choose<DrawTool>> = Id::new("draw_tool");
+pub const FINISH_SHAPE: Id<Button> = Id::new("finish_shape");
+pub const DELETE_SHAPE: Id<Button> = Id::new("delete_shape");
+pub const KEY_SHAPES: Id<Button> = Id::new("key_shapes");
+pub const COPY_SCENE: Id<Button> = Id::new("copy_scene");
 pub const AUTO_LEVELS: Id<Int> = Id::new("auto_levels");
 pub const AUTO_COLOUR: Id<Double> = Id::new("auto_colour");
 pub const AUTO_STRETCH: Id<Double> = Id::new("auto_stretch");

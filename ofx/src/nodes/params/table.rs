@@ -19,7 +19,8 @@ use crate::wrapper::plugin::Context;
 use crate::wrapper::spec::{Kind, ParamSpec, TextMode};
 
 use super::choices::{
-    methods, pattern_label, view_label, views, Affects, EditSides, EvaluationMode, Show, PATTERNS,
+    methods, pattern_label, view_label, views, Affects, DrawTool, EditSides, EvaluationMode, Show,
+    PATTERNS,
 };
 use super::ids::*;
 
@@ -98,7 +99,12 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(TRACK_FORWARD, "Track Forward", "Follows every enabled line through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(TRACK_BACKWARD, "Track Backward", "As Track Forward, towards the start: to the previous key, or the first frame of the clip.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(OVERLAY_SHOW, "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", choice(Show::Both)).in_group("lines_group").animated(false),
-        ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which lines the pen moves in the viewer. Drag an end, or a line by its middle; drag in empty space to draw a new line. Hold Shift to grab only A's lines, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
+        ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which features the pen moves in the viewer (line slots and the shapes of Scene Text). Drag a point, or a feature by its body. Hold Shift to grab only A's, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
+        ParamSpec::new(DRAW_TOOL, "Draw", "What the pen draws in empty space. line: drag a line into the next slot. point: click to add a point to Scene Text. polyline, curve: click to add control points (click the first point to close the shape; click the last again, press Return or Finish Shape to end it open); with these tools a click on a shape's segment inserts a point. New shapes start with B on A: then move B's points.", choice(DrawTool::Line)).in_group("lines_group").animated(false),
+        ParamSpec::new(FINISH_SHAPE, "Finish Shape", "Ends the polyline or curve being drawn, open.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(DELETE_SHAPE, "Delete Shape", "Deletes the shape last drawn or grabbed in the viewer from Scene Text (Delete or Backspace over a point deletes that point).", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(KEY_SHAPES, "Key Shapes Here", "Keys Scene Text's shapes at the current frame (a static scene becomes keyed); from then on an edit at a frame keys that frame.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(COPY_SCENE, "Copy Scene Into Node", "Copies Scene File's scene into Scene Text and empties Scene File, so its shapes can be edited in the viewer.", Kind::Button).in_group("lines_group"),
     ];
     for k in 1..=LINE_SLOTS {
         t.extend(slot_specs(k));

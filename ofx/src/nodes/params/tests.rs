@@ -71,6 +71,7 @@ const RELEASED_BOTH: &[(&str, &[&str])] = &[
         &["A and B", "A only", "B only", "in-between", "off"],
     ),
     ("overlay_edit", &["A and B", "A only", "B only"]),
+    ("draw_tool", &["line", "point", "polyline", "curve"]),
 ];
 
 fn released() -> Vec<(NodeKind, &'static str, &'static [&'static str])> {

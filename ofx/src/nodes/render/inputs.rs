@@ -14,7 +14,10 @@ use crate::wrapper::plugin::Context;
 use crate::wrapper::{Failure, Outcome};
 
 /// The scene named by the params, parsed once per content.
-fn load_scene(instance: &NodeState, settings: &Settings) -> Outcome<Option<Arc<Scene>>> {
+pub(in crate::nodes) fn load_scene(
+    instance: &NodeState,
+    settings: &Settings,
+) -> Outcome<Option<Arc<Scene>>> {
     let path = settings.scene_file.trim();
     let (key, source) = if !path.is_empty() {
         let meta = std::fs::metadata(path)

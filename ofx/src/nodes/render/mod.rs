@@ -31,8 +31,8 @@ use crate::wrapper::clips::{Depth, EffectHandle, HostImage, HostSample, ImageInf
 use crate::wrapper::plugin::RenderArgs;
 use crate::wrapper::{Failure, Outcome};
 use draw::Job;
-pub(super) use inputs::warp_inputs;
 use inputs::WarpInputs;
+pub(super) use inputs::{load_scene, warp_inputs};
 pub use regions::{
     clip_preferences, frames_needed, is_identity, region_of_definition, regions_of_interest,
 };
