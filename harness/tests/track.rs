@@ -462,3 +462,58 @@ fn track_keys_no_further_than_a_line_is_seen_and_names_where_it_lost_it() {
         "{said:?}"
     );
 }
+
+#[test]
+fn track_forward_keys_scene_text_shapes_at_every_frame_in_one_write() {
+    let motion = button_motion();
+    let inst = common::bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let source = shot("OfxBitDepthFloat", &motion);
+    inst.connect("SourceA", source.clone()).unwrap();
+    inst.connect("SourceB", source).unwrap();
+    // A static scene: a closed curve through four points, and a point.
+    let curve_a = [(60.0, 50.0), (120.0, 55.0), (125.0, 100.0), (65.0, 105.0)];
+    let curve_b = [(70.0, 60.0), (110.0, 50.0), (130.0, 95.0), (60.0, 110.0)];
+    let json = |pts: &[(f64, f64)]| {
+        let v: Vec<String> = pts.iter().map(|(x, y)| format!("[{x}, {y}]")).collect();
+        format!("[{}]", v.join(", "))
+    };
+    let text = format!(
+        r#"{{"features": [
+            {{"name": "face", "type": "curve", "closed": true, "a": {}, "b": {}}},
+            {{"type": "point", "a": [[90, 80]], "b": [[95, 82]]}}
+        ]}}"#,
+        json(&curve_a),
+        json(&curve_b)
+    );
+    inst.set_string("scene_text", &text).unwrap();
+    morphfx_harness::host::params::take_edit_log();
+    inst.instance_changed("track_forward", 0.0).unwrap();
+    let log = morphfx_harness::host::params::take_edit_log();
+    assert_eq!(log, ["begin Track Forward", "set scene_text", "end"]);
+    let scene = morphfx::scene::Scene::read(&inst.string("scene_text").unwrap()).unwrap();
+    let frames: Vec<f64> = scene.keyframes.iter().map(|k| k.frame).collect();
+    assert_eq!(frames, (0..=10).map(f64::from).collect::<Vec<_>>());
+    let v = |(x, y): (f64, f64)| Vec2::new(x, y);
+    let face = &scene.keyframes[0].features[0];
+    assert!(face.closed && face.name.as_deref() == Some("face"));
+    assert_eq!(face.a, curve_a.map(v), "frame 0 keeps the user's shape");
+    let mut worst = 0.0f64;
+    for (f, key) in scene.keyframes.iter().enumerate() {
+        for (tracked, (a, b)) in [
+            (&key.features[0], (&curve_a.map(v)[..], &curve_b.map(v)[..])),
+            (
+                &key.features[1],
+                (&[v((90.0, 80.0))][..], &[v((95.0, 82.0))][..]),
+            ),
+        ] {
+            for (side_points, start) in [(&tracked.a, a), (&tracked.b, b)] {
+                for (p, s) in side_points.iter().zip(start) {
+                    worst = worst.max(p.distance(motion.at(f, *s)));
+                }
+            }
+        }
+    }
+    assert!(worst < 0.3, "worst {worst} px off the true motion");
+}

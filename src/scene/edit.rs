@@ -77,6 +77,26 @@ impl Document {
         })
     }
 
+    /// Sets the points of many features at many frames in one edit (what a
+    /// tracker found): `(frame, feature, side, points)`, each keyed like
+    /// [`Document::set_point`].
+    pub fn set_points(&mut self, keys: &[(f64, usize, Side, Vec<Vec2>)]) -> Result<()> {
+        self.edit(|doc| {
+            for (frame, feature, side, points) in keys {
+                let f = doc.feature_at(*frame, *feature)?;
+                let slots = side_points(f, *side)?;
+                if slots.len() != points.len() {
+                    return Err(missing(*feature, "the points set"));
+                }
+                for (slot, p) in slots.iter_mut().zip(points) {
+                    *slot = point_json(*p);
+                }
+                forget_track(f);
+            }
+            Ok(())
+        })
+    }
+
     /// Moves every point of feature `feature` on `side` at `frame` to
     /// `from[i] + delta`.
     pub fn move_feature(
@@ -249,8 +269,13 @@ struct Editor<'s> {
 }
 
 impl Editor<'_> {
+    /// Whether the JSON is keyed now (an earlier step of the same edit may
+    /// have keyed a static scene).
     fn is_keyed(&self) -> bool {
-        !self.scene.keyframes.is_empty()
+        self.root
+            .get("keyframes")
+            .and_then(Value::as_array)
+            .is_some_and(|k| !k.is_empty())
     }
 
     /// Every feature list: each keyframe's, or the static one.

@@ -181,3 +181,26 @@ fn an_edit_that_breaks_the_scene_is_refused_and_leaves_the_document() {
     assert!(Document::parse("{ not json").is_err());
     assert!(d.set_point(0.0, 7, Side::A, 0, Vec2::ZERO).is_err());
 }
+
+#[test]
+fn many_keys_in_one_edit_key_a_static_scene_at_each_frame() {
+    let mut d = Document::parse(STATIC).unwrap();
+    let nose = |dx: f64| vec![Vec2::new(410.0 + dx, 300.0), Vec2::new(412.0 + dx, 220.0)];
+    d.key_here(1001.0).unwrap();
+    d.set_points(&[
+        (1002.0, 0, Side::A, nose(1.0)),
+        (1003.0, 0, Side::A, nose(2.0)),
+    ])
+    .unwrap();
+    assert_eq!(d.keyed_frames(), [1001.0, 1002.0, 1003.0]);
+    let s = d.scene();
+    assert_eq!(s.keyframes[0].features[0].a[0], Vec2::new(410.1, 300.0));
+    assert_eq!(s.keyframes[2].features[0].a, nose(2.0));
+    // The other feature, not set, is held at every new key.
+    assert_eq!(s.keyframes[2].features[1], s.keyframes[0].features[1]);
+    // A point list of the wrong length is refused whole.
+    assert!(d
+        .set_points(&[(1004.0, 0, Side::A, vec![Vec2::ZERO])])
+        .is_err());
+    assert_eq!(d.keyed_frames(), [1001.0, 1002.0, 1003.0]);
+}

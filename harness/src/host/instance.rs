@@ -245,6 +245,27 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// A string param's value.
+    pub fn string(&self, name: &str) -> Result<String, HostError> {
+        Ok(self
+            .param(name)?
+            .value_at(0.0)
+            .s
+            .to_string_lossy()
+            .into_owned())
+    }
+
+    /// The persistent message the plugin has on the node (message suite
+    /// v2), if any.
+    pub fn persistent_message(&self) -> Option<String> {
+        self.effect
+            .persistent
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .as_ref()
+            .map(|m| m.text.clone())
+    }
+
     pub fn set_string(&self, name: &str, value: &str) -> Result<(), HostError> {
         let p = self.param(name)?;
         p.set(ParamValue {

@@ -198,6 +198,13 @@ impl<'i> Overlay<'i> {
         self.call(action, Some(&a))
     }
 
+    /// A click: pen down and up at `at`, what the pen down answered.
+    pub fn click(&self, time: f64, at: (f64, f64), pixel: (f64, f64)) -> Result<Answer, HostError> {
+        let down = self.pen(kOfxInteractActionPenDown, time, at, pixel)?;
+        self.pen(kOfxInteractActionPenUp, time, at, pixel)?;
+        Ok(down)
+    }
+
     /// A whole drag: pen down at `from`, motion to `to`, pen up there.
     pub fn drag(
         &self,

@@ -1,7 +1,9 @@
 //! The Track Forward and Track Backward push-buttons: every enabled line
-//! slot followed through its source from the current frame, one frame at a
-//! time, to the slot's next key in that direction (or the end of the clip),
-//! keyed at each frame: A's ends on Source A, B's on Source B (Morph).
+//! slot and every shape of Scene Text followed through its source from the
+//! current frame, one frame at a time, to the next key in that direction
+//! (or the end of the clip), keyed at each frame: A's points on Source A,
+//! B's on Source B (Morph). Slots are keyed in their params; shapes in
+//! Scene Text, written once at the end (one undo step with the slots').
 //!
 //! The core's tracker does the work (docs/tracking.md): each frame is
 //! matched against the current frame's picture, so nothing drifts. A line
@@ -14,7 +16,10 @@ use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::{PixelScale, Vec2};
 use morphfx::track::{Grey, Pyramid, SideTracker, TrackSettings};
 
+use morphfx::scene::edit::Document;
+
 use super::lines::{end_id, slot_lines, SlotLine};
+use super::overlay::shapes;
 use super::params::{Reader, Settings};
 use super::{NodeKind, NodeState};
 use crate::wrapper::clips::{Depth, EffectHandle};
@@ -25,9 +30,18 @@ use crate::wrapper::{Failure, Outcome};
 /// Frames tracked at most when neither keys nor the clip say where to stop.
 const MAX_FRAMES: i64 = 10_000;
 
-/// One side of one slot being tracked.
+/// What a follower keys.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    /// Line slot `k`: its end params.
+    Slot(usize),
+    /// Scene Text's feature `i`.
+    Shape(usize),
+}
+
+/// One side of one slot or shape being tracked.
 struct Follower {
-    slot: usize,
+    target: Target,
     side: Side,
     tracker: SideTracker,
     /// The first frame it lost track at, after which it is keyed no more.
@@ -64,11 +78,19 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
     let kind = instance.kind;
     let params = instance.params();
     let lines = slot_lines(&Reader::new(params, kind, time));
-    if lines.is_empty() {
+    // Scene Text's shapes when the viewer may edit them (a Scene File's
+    // features are not the node's to key).
+    let doc = shapes::document(instance, time).ok();
+    let shape_list = doc
+        .as_ref()
+        .map(|d| d.scene().features_at(time))
+        .unwrap_or_default();
+    if lines.is_empty() && shape_list.is_empty() {
         return Ok(());
     }
     let sources = sources((kind, instance.context), effect, params, time)?;
-    let stop = stop_frame(params, effect, &sources, &lines, time, step);
+    let shape_keys = doc.as_ref().map(Document::keyed_frames).unwrap_or_default();
+    let stop = stop_frame(params, effect, &sources, (&lines, &shape_keys), time, step);
     let settings = TrackSettings::default();
     let mut followers = Vec::new();
     for (side, source) in &sources {
@@ -78,12 +100,20 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
                 source.clip
             ))
         })?;
-        for line in &lines {
-            let ends = line.side(*side).map(|p| scale.to_pixel(p));
+        let slots = lines.iter().map(|l| {
+            let ends = l.side(*side);
+            (Target::Slot(l.slot), FeatureKind::Line, ends.to_vec())
+        });
+        let shapes = shape_list
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (Target::Shape(i), f.kind, f.points(*side).to_vec()));
+        for (target, kind, points) in slots.chain(shapes) {
+            let px: Vec<Vec2> = points.iter().map(|p| scale.to_pixel(*p)).collect();
             followers.push(Follower {
-                slot: line.slot,
+                target,
                 side: *side,
-                tracker: SideTracker::new(FeatureKind::Line, &ends, &key, &settings),
+                tracker: SideTracker::new(kind, &px, &key, &settings),
                 lost_at: None,
             });
         }
@@ -95,21 +125,41 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
     };
     effect.progress_start(label);
     let result = params.edit_block(label, || {
-        sweep(
+        let mut keys = Vec::new();
+        let swept = sweep(
             effect,
             params,
             &sources,
             &mut followers,
             (time, stop, step),
             &settings,
-        )
+            &mut keys,
+        );
+        // The shapes' keys made so far are written even after a failure or
+        // a cancel, as the slots' are.
+        let written = match doc {
+            Some(mut doc) if !keys.is_empty() => key_shapes(instance, &mut doc, time, &keys),
+            _ => Ok(()),
+        };
+        swept.and(written)
     });
     effect.progress_end();
     instance.purge();
     result?;
-    report_lost(effect, &followers);
+    report_lost(effect, &followers, &shape_list);
     Ok(())
 }
+
+/// Keys Scene Text's shapes: at the start frame as they are (so a static
+/// scene keeps its shape there), then where the tracker found them.
+fn key_shapes(instance: &NodeState, doc: &mut Document, time: f64, keys: &[ShapeKey]) -> Outcome {
+    doc.key_here(time).map_err(shapes::refused)?;
+    doc.set_points(keys).map_err(shapes::refused)?;
+    shapes::write(instance, doc)
+}
+
+/// A shape's points found at a frame: `(frame, feature, side, points)`.
+type ShapeKey = (f64, usize, Side, Vec<Vec2>);
 
 /// The node's sources with their sides and frame offsets, each connected.
 fn sources<'e>(
@@ -141,13 +191,13 @@ fn sources<'e>(
         .collect()
 }
 
-/// The last frame to key: before the nearest key of any tracked end beyond
-/// `time`, else the clip's last (or first) frame.
+/// The last frame to key: before the nearest key of any tracked slot end
+/// or of the shapes beyond `time`, else the clip's last (or first) frame.
 fn stop_frame(
     params: &Params,
     effect: &EffectHandle,
     sources: &[(Side, Source<'_>)],
-    lines: &[SlotLine],
+    (lines, shape_keys): (&[SlotLine], &[f64]),
     time: f64,
     step: i64,
 ) -> f64 {
@@ -158,6 +208,7 @@ fn stop_frame(
         .flat_map(|(slot, side)| (0..2).map(move |end| end_id(slot, side, end)))
         // A host that cannot list keys: the clip's end decides.
         .flat_map(|id| params.key_times(id.name()).unwrap_or_default())
+        .chain(shape_keys.iter().copied())
         .filter(|t| (t - time) * dir > 0.5)
         .min_by(|x, y| ((x - time) * dir).total_cmp(&((y - time) * dir)));
     if let Some(key) = next_key {
@@ -190,6 +241,7 @@ fn sweep(
     followers: &mut [Follower],
     (time, stop, step): (f64, f64, i64),
     settings: &TrackSettings,
+    shape_keys: &mut Vec<ShapeKey>,
 ) -> Outcome {
     let total = ((stop - time) * step as f64).round().max(0.0) as i64;
     for n in 1..=total {
@@ -208,9 +260,18 @@ fn sweep(
                     f.lost_at = Some(frame);
                     continue;
                 }
-                for (end, p) in e.points.iter().enumerate() {
-                    let at = Vec2::new(p.x / scale.x, p.y / scale.y);
-                    params.set_point_at(end_id(f.slot, f.side, end).name(), frame, (at.x, at.y))?;
+                let found = e
+                    .points
+                    .iter()
+                    .map(|p| Vec2::new(p.x / scale.x, p.y / scale.y));
+                match f.target {
+                    Target::Slot(slot) => {
+                        for (end, at) in found.enumerate() {
+                            let id = end_id(slot, f.side, end);
+                            params.set_point_at(id.name(), frame, (at.x, at.y))?;
+                        }
+                    }
+                    Target::Shape(i) => shape_keys.push((frame, i, f.side, found.collect())),
                 }
             }
         }
@@ -223,14 +284,24 @@ fn sweep(
     Ok(())
 }
 
-/// Names each line that lost track, and where.
-fn report_lost(effect: &EffectHandle, followers: &[Follower]) {
+/// Names each line or shape that lost track, and where.
+fn report_lost(
+    effect: &EffectHandle,
+    followers: &[Follower],
+    shapes: &[morphfx::features::Feature],
+) {
     let lost: Vec<String> = followers
         .iter()
         .filter_map(|f| {
             let side = if f.side == Side::A { "A" } else { "B" };
-            f.lost_at
-                .map(|t| format!("line {} on {side} at frame {t}", f.slot))
+            let what = match f.target {
+                Target::Slot(k) => format!("line {k}"),
+                Target::Shape(i) => match shapes.get(i).and_then(|s| s.name.as_deref()) {
+                    Some(name) => format!("shape \"{name}\""),
+                    None => format!("shape #{}", i + 1),
+                },
+            };
+            f.lost_at.map(|t| format!("{what} on {side} at frame {t}"))
         })
         .collect();
     if !lost.is_empty() {
@@ -238,7 +309,11 @@ fn report_lost(effect: &EffectHandle, followers: &[Follower]) {
             c"net.morphfx.track.lost",
             &format!(
                 "Track lost {} (not keyed from there: key it by hand and track again): {}",
-                if lost.len() == 1 { "a line" } else { "lines" },
+                if lost.len() == 1 {
+                    "a feature"
+                } else {
+                    "features"
+                },
                 lost.join(", ")
             ),
         );

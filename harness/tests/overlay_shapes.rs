@@ -1,0 +1,449 @@
+//! Shapes in the viewer through the C ABI: Scene Text's points, polylines
+//! and curves drawn by the overlay, drawn and edited with the pen, keyed,
+//! and refused when the text is not a scene.
+
+mod common;
+
+use std::sync::OnceLock;
+
+use morphfx::features::{catmull_rom, FeatureKind};
+use morphfx::geom::Vec2;
+use morphfx::scene::Scene;
+use morphfx_harness::host::overlay::{Answer, DrawCall, Overlay};
+use morphfx_harness::host::params::take_edit_log;
+use morphfx_harness::host::{take_violations, Bundle, HostOptions, Instance};
+use openfx::sys::image_effect_v1::draw_suite::*;
+use openfx::sys::image_effect_v1::interact::*;
+use serde_json::Value;
+
+fn bundle() -> &'static Bundle {
+    static B: OnceLock<Bundle> = OnceLock::new();
+    B.get_or_init(|| {
+        let options = HostOptions {
+            overlays: true,
+            draw_suite: true,
+        };
+        Bundle::load_with(&common::bundle_path(), options).expect("the bundle loads")
+    })
+}
+
+fn morph() -> Instance<'static> {
+    bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap()
+}
+
+fn overlay<'i>(inst: &'i Instance<'i>) -> Overlay<'i> {
+    Overlay::new(inst, true)
+        .unwrap()
+        .expect("the node declares an overlay")
+}
+
+const PX: (f64, f64) = (1.0, 1.0);
+
+/// A point, a curve "lip" and a closed polyline "eye", static.
+const SHAPES: &str = r#"{
+  "format": "morphfx-scene", "version": 1,
+  "features": [
+    { "type": "point", "a": [[50, 50]], "b": [[55, 52]] },
+    { "name": "lip", "type": "curve", "a": [[100, 100], [150, 130], [200, 100]], "b": [[100, 110], [150, 150], [200, 110]] },
+    { "name": "eye", "type": "polyline", "closed": true, "a": [[300, 300], [340, 300], [320, 330]], "b": [[300, 310], [340, 310], [320, 345]] }
+  ]
+}"#;
+
+/// The lip keyed at frames 0 and 10 (A's middle point rises by 20).
+const KEYED: &str = r#"{"keyframes": [
+  {"frame": 0,  "features": [{"name": "lip", "type": "curve", "a": [[100, 100], [150, 130], [200, 100]], "b": [[100, 110], [150, 150], [200, 110]]}]},
+  {"frame": 10, "features": [{"name": "lip", "type": "curve", "a": [[100, 100], [150, 150], [200, 100]], "b": [[100, 110], [150, 150], [200, 110]]}]}
+]}"#;
+
+fn scene_text(inst: &Instance<'_>) -> String {
+    inst.string("scene_text").unwrap()
+}
+
+fn scene(inst: &Instance<'_>) -> Scene {
+    Scene::read(&scene_text(inst)).expect("Scene Text stays a valid scene")
+}
+
+/// Every number in a JSON document, with its path.
+fn numbers(v: &Value, path: String, out: &mut Vec<(String, f64)>) {
+    match v {
+        Value::Number(n) => out.push((path, n.as_f64().unwrap())),
+        Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                numbers(v, format!("{path}[{i}]"), out);
+            }
+        }
+        Value::Object(o) => {
+            for (k, v) in o {
+                numbers(v, format!("{path}.{k}"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The numbers of `after` that differ from `before`'s (same layout).
+fn changed(before: &str, after: &str) -> Vec<(String, f64)> {
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    numbers(
+        &serde_json::from_str(before).unwrap(),
+        String::new(),
+        &mut x,
+    );
+    numbers(&serde_json::from_str(after).unwrap(), String::new(), &mut y);
+    assert_eq!(
+        x.iter().map(|p| &p.0).collect::<Vec<_>>(),
+        y.iter().map(|p| &p.0).collect::<Vec<_>>(),
+        "same layout"
+    );
+    x.into_iter()
+        .zip(y)
+        .filter(|(p, q)| p.1 != q.1)
+        .map(|(_, q)| q)
+        .collect()
+}
+
+/// Every point of every line strip drawn in colour `rgb` (any alpha).
+fn strips_in(calls: &[DrawCall], rgb: [f32; 3]) -> Vec<Vec<[f64; 2]>> {
+    let mut colour = [0.0f32; 4];
+    let mut out = Vec::new();
+    for c in calls {
+        match c {
+            DrawCall::Colour(c) => colour = *c,
+            DrawCall::Draw { primitive, points }
+                if *primitive == kOfxDrawPrimitiveLineStrip && colour[..3] == rgb =>
+            {
+                out.push(points.clone())
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+fn texts(calls: &[DrawCall]) -> Vec<String> {
+    calls
+        .iter()
+        .filter_map(|c| match c {
+            DrawCall::Text { text, .. } => Some(text.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+const A_COLOUR: [f32; 3] = [1.0, 0.55, 0.1];
+const B_COLOUR: [f32; 3] = [0.25, 0.8, 1.0];
+
+fn close(p: [f64; 2], q: Vec2) -> bool {
+    (p[0] - q.x).abs() < 1e-9 && (p[1] - q.y).abs() < 1e-9
+}
+
+#[test]
+fn scene_text_shapes_are_drawn_as_catmull_rom_and_closed_with_names() {
+    let inst = morph();
+    inst.set_string("scene_text", SHAPES).unwrap();
+    let ov = overlay(&inst);
+    let calls = ov.draw(0.0, PX).unwrap();
+    // The lip on A: a strip through the Catmull-Rom samples of its points.
+    let lip_a = [(100.0, 100.0), (150.0, 130.0), (200.0, 100.0)].map(|(x, y)| Vec2::new(x, y));
+    let a = strips_in(&calls, A_COLOUR);
+    let lip = a
+        .iter()
+        .find(|s| s.len() == 17)
+        .expect("a 2-span curve drawn with 8 samples a span");
+    for (k, p) in lip.iter().enumerate() {
+        let want = if k == 16 {
+            lip_a[2]
+        } else {
+            catmull_rom(&lip_a, k / 8, (k % 8) as f64 / 8.0)
+        };
+        assert!(close(*p, want), "sample {k}: {p:?} vs {want:?}");
+    }
+    // The closed eye on B: four points, back to its first.
+    let b = strips_in(&calls, B_COLOUR);
+    assert!(
+        b.contains(&vec![
+            [300.0, 310.0],
+            [340.0, 310.0],
+            [320.0, 345.0],
+            [300.0, 310.0]
+        ]),
+        "{b:?}"
+    );
+    // Names, else the place in the scene, beside A and B (and shadows).
+    let labels = texts(&calls);
+    for name in ["lip", "eye", "#1"] {
+        assert_eq!(
+            labels.iter().filter(|t| *t == name).count(),
+            4,
+            "{name}: {labels:?}"
+        );
+    }
+    assert!(take_violations().is_empty());
+}
+
+#[test]
+fn dragging_a_control_point_changes_exactly_that_number_pair_in_one_undo_step() {
+    let inst = morph();
+    inst.set_string("scene_text", SHAPES).unwrap();
+    let before = scene_text(&inst);
+    let ov = overlay(&inst);
+    take_edit_log();
+    // The lip's middle point on B, (150, 150), to (160, 171.5).
+    let answer = ov.drag(0.0, (151.0, 151.0), (160.0, 171.5), PX).unwrap();
+    assert_eq!(answer, Answer::Trapped);
+    let after = scene_text(&inst);
+    assert_eq!(
+        changed(&before, &after),
+        [
+            (".features[1].b[1][0]".to_owned(), 160.0),
+            (".features[1].b[1][1]".to_owned(), 171.5)
+        ]
+    );
+    let log = take_edit_log();
+    assert_eq!(
+        log.first().map(String::as_str),
+        Some("begin Move Shape Point")
+    );
+    assert_eq!(log.last().map(String::as_str), Some("end"));
+    assert_eq!(log.iter().filter(|l| l.starts_with("begin")).count(), 1);
+    // One write per pen event: down, two motions, up.
+    assert_eq!(
+        log.iter().filter(|l| *l == "set scene_text").count(),
+        4,
+        "{log:?}"
+    );
+}
+
+#[test]
+fn in_a_keyed_scene_a_drag_keys_its_frame_and_leaves_the_other_keys() {
+    let inst = morph();
+    inst.set_string("scene_text", KEYED).unwrap();
+    let ov = overlay(&inst);
+    // At frame 10 the key exists: only its number moves.
+    let before = scene_text(&inst);
+    ov.drag(10.0, (150.0, 150.5), (150.0, 160.0), PX).unwrap();
+    assert_eq!(
+        changed(&before, &scene_text(&inst)),
+        [(".keyframes[1].features[0].a[1][1]".to_owned(), 160.0)]
+    );
+    // At frame 5 there is none: one is made from the interpolated lip
+    // (A's middle at (150, 145)), then edited; the keys at 0 and 10 stay.
+    ov.drag(5.0, (150.0, 145.0), (170.0, 145.0), PX).unwrap();
+    let s = scene(&inst);
+    let frames: Vec<f64> = s.keyframes.iter().map(|k| k.frame).collect();
+    assert_eq!(frames, [0.0, 5.0, 10.0]);
+    assert_eq!(s.keyframes[1].features[0].a[1], Vec2::new(170.0, 145.0));
+    assert_eq!(s.keyframes[1].features[0].a[0], Vec2::new(100.0, 100.0));
+    assert_eq!(s.keyframes[0].features[0].a[1], Vec2::new(150.0, 130.0));
+    assert_eq!(s.keyframes[2].features[0].a[1], Vec2::new(150.0, 160.0));
+    // The overlay says where the shapes are keyed, the current frame marked.
+    let labels = texts(&ov.draw(5.0, PX).unwrap());
+    assert!(labels.iter().any(|t| t == "keys 0 [5] 10"), "{labels:?}");
+}
+
+#[test]
+fn dragging_a_body_moves_the_whole_shape_on_that_side_only() {
+    let inst = morph();
+    inst.set_string("scene_text", SHAPES).unwrap();
+    let ov = overlay(&inst);
+    // The eye's A edge from (300, 300) to (340, 300), grabbed at its middle.
+    ov.drag(0.0, (320.0, 301.0), (330.0, 296.0), PX).unwrap();
+    let eye = &scene(&inst).features[2];
+    let moved = [(310.0, 295.0), (350.0, 295.0), (330.0, 325.0)].map(|(x, y)| Vec2::new(x, y));
+    assert_eq!(eye.a, moved);
+    assert_eq!(eye.b[0], Vec2::new(300.0, 310.0), "B stays");
+    assert!(eye.closed);
+}
+
+#[test]
+fn the_point_tool_adds_a_point_with_b_on_a() {
+    let inst = morph();
+    inst.set_string("scene_text", SHAPES).unwrap();
+    inst.set_choice("draw_tool", "point").unwrap();
+    let ov = overlay(&inst);
+    take_edit_log();
+    assert_eq!(ov.click(0.0, (600.0, 400.0), PX).unwrap(), Answer::Trapped);
+    let s = scene(&inst);
+    assert_eq!(s.features.len(), 4);
+    let p = &s.features[3];
+    assert_eq!(p.kind, FeatureKind::Point);
+    assert_eq!(
+        (p.a[0], p.b[0]),
+        (Vec2::new(600.0, 400.0), Vec2::new(600.0, 400.0))
+    );
+    let log = take_edit_log();
+    assert_eq!(log.first().map(String::as_str), Some("begin New Point"));
+    assert_eq!(log.iter().filter(|l| l.starts_with("begin")).count(), 1);
+}
+
+#[test]
+fn polylines_close_on_their_first_point_and_curves_end_open() {
+    let inst = morph();
+    inst.set_choice("draw_tool", "polyline").unwrap();
+    let ov = overlay(&inst);
+    // An empty Scene Text: the first shape makes the document.
+    for at in [(10.0, 10.0), (90.0, 10.0), (50.0, 70.0)] {
+        ov.click(0.0, at, PX).unwrap();
+    }
+    // Drawn so far, before it is closed: the points joined.
+    let calls = ov.draw(0.0, PX).unwrap();
+    assert!(strips_in(&calls, A_COLOUR)
+        .iter()
+        .any(|s| s[..] == [[10.0, 10.0], [90.0, 10.0], [50.0, 70.0]]));
+    ov.click(0.0, (12.0, 11.0), PX).unwrap();
+    let s = scene(&inst);
+    assert_eq!(s.features.len(), 1);
+    let tri = &s.features[0];
+    assert_eq!(
+        (tri.kind, tri.closed, tri.a.len()),
+        (FeatureKind::Polyline, true, 3)
+    );
+    assert_eq!(tri.a, tri.b, "new shapes start with B on A");
+    // A curve: three clicks, then a second click on the last point ends it
+    // open; then another by Return, and a third by the Finish Shape button.
+    inst.set_choice("draw_tool", "curve").unwrap();
+    let finishers: [&dyn Fn(); 3] = [
+        &|| {
+            ov.click(0.0, (300.0, 250.0), PX).unwrap();
+        },
+        &|| {
+            let ret = 0xff0d;
+            assert_eq!(
+                ov.key(kOfxInteractActionKeyDown, 0.0, ret).unwrap(),
+                Answer::Trapped
+            );
+        },
+        &|| inst.instance_changed("finish_shape", 0.0).unwrap(),
+    ];
+    for (k, finish) in finishers.iter().enumerate() {
+        let y = 200.0 + 100.0 * k as f64;
+        for x in [100.0, 200.0, 300.0] {
+            ov.click(0.0, (x, y + 50.0 * (k == 0 && x == 300.0) as u8 as f64), PX)
+                .unwrap();
+        }
+        finish();
+        let s = scene(&inst);
+        let c = &s.features[1 + k];
+        assert_eq!(
+            (c.kind, c.closed, c.a.len()),
+            (FeatureKind::Curve, false, 3),
+            "{k}"
+        );
+    }
+    // After finishing, a click in empty space starts a new curve (nothing
+    // is written until its second point).
+    ov.click(0.0, (700.0, 700.0), PX).unwrap();
+    assert_eq!(scene(&inst).features.len(), 4);
+}
+
+#[test]
+fn the_curve_tool_inserts_a_point_on_a_segment_and_delete_removes_points_and_shapes() {
+    let inst = morph();
+    inst.set_string("scene_text", SHAPES).unwrap();
+    inst.set_choice("draw_tool", "curve").unwrap();
+    let ov = overlay(&inst);
+    // The eye's closing A segment, (320, 330) back to (300, 300): a click
+    // halfway inserts a point there on A, and on B halfway along B's.
+    take_edit_log();
+    ov.click(0.0, (310.0, 315.0), PX).unwrap();
+    let eye = &scene(&inst).features[2];
+    assert_eq!(eye.a.len(), 4);
+    assert_eq!(eye.a[3], Vec2::new(310.0, 315.0));
+    assert_eq!(eye.b[3], Vec2::new(310.0, 327.5));
+    assert_eq!(
+        take_edit_log().first().map(String::as_str),
+        Some("begin Insert Shape Point")
+    );
+    // Hover that point and press Delete: back to three points.
+    let delete = 0xffff;
+    ov.pen(kOfxInteractActionPenMotion, 0.0, (310.0, 315.0), PX)
+        .unwrap();
+    assert_eq!(
+        ov.key(kOfxInteractActionKeyDown, 0.0, delete).unwrap(),
+        Answer::Trapped
+    );
+    assert_eq!(scene(&inst).features[2].a.len(), 3);
+    // Delete over a body deletes the shape; so does Delete Shape on the
+    // last grabbed one.
+    ov.pen(kOfxInteractActionPenMotion, 0.0, (320.0, 300.0), PX)
+        .unwrap();
+    ov.key(kOfxInteractActionKeyDown, 0.0, delete).unwrap();
+    assert_eq!(scene(&inst).features.len(), 2);
+    inst.set_choice("draw_tool", "line").unwrap();
+    ov.drag(0.0, (50.0, 50.0), (51.0, 51.0), PX).unwrap();
+    inst.instance_changed("delete_shape", 0.0).unwrap();
+    let s = scene(&inst);
+    assert_eq!(s.features.len(), 1);
+    assert_eq!(s.features[0].name.as_deref(), Some("lip"));
+}
+
+#[test]
+fn key_shapes_here_and_copy_scene_into_node() {
+    let inst = morph();
+    inst.set_string("scene_text", SHAPES).unwrap();
+    inst.instance_changed("key_shapes", 12.0).unwrap();
+    let s = scene(&inst);
+    assert_eq!(s.keyframes.len(), 1);
+    assert_eq!(s.keyframes[0].frame, 12.0);
+    assert_eq!(s.features_at(0.0), Scene::read(SHAPES).unwrap().features);
+    // A scene file's features are drawn, dimmer, and the pen cannot move them.
+    let dir = common::scratch("overlay-shapes-copy");
+    let path = dir.join("face.morph.json");
+    std::fs::write(&path, SHAPES).unwrap();
+    let inst = morph();
+    inst.set_string("scene_file", &path.to_string_lossy())
+        .unwrap();
+    let ov = overlay(&inst);
+    let dim = ov
+        .draw(0.0, PX)
+        .unwrap()
+        .iter()
+        .any(|c| matches!(c, DrawCall::Colour(c) if c[..3] == A_COLOUR && c[3] < 0.5));
+    assert!(dim, "file features drawn at reduced alpha");
+    // The pen passes through them: a new point is refused (it would go
+    // into Scene Text, which does not render while the file is in use).
+    inst.set_choice("draw_tool", "point").unwrap();
+    ov.drag(0.0, (150.0, 130.0), (170.0, 130.0), PX).unwrap();
+    let message = inst.persistent_message().expect("a message on the node");
+    assert!(message.contains("Copy Scene Into Node"), "{message}");
+    assert_eq!(scene_text(&inst), "");
+    inst.instance_changed("copy_scene", 0.0).unwrap();
+    assert_eq!(inst.string("scene_file").unwrap(), "");
+    assert_eq!(scene_text(&inst), SHAPES);
+    ov.drag(0.0, (150.0, 130.0), (170.0, 130.0), PX).unwrap();
+    assert_eq!(scene(&inst).features[1].a[1], Vec2::new(170.0, 130.0));
+}
+
+#[test]
+fn a_scene_text_that_is_not_a_scene_is_drawn_as_nothing_and_never_overwritten() {
+    let inst = morph();
+    // Valid JSON, bad scene: a polyline with one point.
+    let bad = r#"{"features": [{"type": "polyline", "a": [[1, 1]], "b": [[1, 1]]}]}"#;
+    inst.set_string("scene_text", bad).unwrap();
+    inst.set_int("line_count", 1).unwrap();
+    inst.set_double("line1_a_start", &[10.0, 10.0], None)
+        .unwrap();
+    inst.set_double("line1_a_end", &[60.0, 10.0], None).unwrap();
+    let ov = overlay(&inst);
+    let calls = ov.draw(0.0, PX).unwrap();
+    assert!(strips_in(&calls, A_COLOUR).is_empty(), "no shape drawn");
+    assert!(texts(&calls).iter().any(|t| t == "1"), "the slot still is");
+    for tool in ["point", "polyline"] {
+        inst.set_choice("draw_tool", tool).unwrap();
+        ov.click(0.0, (400.0, 400.0), PX).unwrap();
+        assert_eq!(scene_text(&inst), bad);
+        let message = inst.persistent_message().expect("a message on the node");
+        assert!(
+            message.contains("Scene Text is not a valid scene") && message.contains("features[0]"),
+            "{message}"
+        );
+    }
+    // Fixed text: the next edit works and clears the message.
+    inst.set_string("scene_text", "").unwrap();
+    inst.set_choice("draw_tool", "point").unwrap();
+    ov.click(0.0, (400.0, 400.0), PX).unwrap();
+    assert_eq!(scene(&inst).features.len(), 1);
+    assert_eq!(inst.persistent_message(), None);
+}
