@@ -642,3 +642,47 @@ fn snap_lines_without_a_source_is_bad_input() {
     let err = inst.instance_changed("snap_lines", 1.0).unwrap_err();
     assert!(err.message.contains("SourceA"), "{}", err.message);
 }
+
+#[test]
+fn snap_lines_slides_scene_text_curves_onto_each_sides_edge() {
+    let bounds = RectI::new(0, 0, 64, 48);
+    let inst = bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let plate = |edge| {
+        let img = morphfx::testing::step_plate(bounds, edge);
+        Arc::new(Still(Arc::new(Frame::from_image(
+            &img,
+            "OfxBitDepthFloat",
+            false,
+        ))))
+    };
+    inst.connect("SourceA", plate(24.0)).unwrap();
+    inst.connect("SourceB", plate(36.0)).unwrap();
+    // A curve 3 px off each side's edge, and a point that must not move.
+    let text = r#"{"features": [
+        {"name": "edge", "type": "curve", "a": [[27, 8], [26, 24], [27, 40]], "b": [[33, 8], [33.5, 24], [33, 40]]},
+        {"type": "point", "a": [[10, 10]], "b": [[12, 10]]}
+    ]}"#;
+    inst.set_string("scene_text", text).unwrap();
+    morphfx_harness::host::params::take_edit_log();
+    inst.instance_changed("snap_lines", 3.0).unwrap();
+    let log = morphfx_harness::host::params::take_edit_log();
+    assert_eq!(log, ["begin Snap Lines", "set scene_text", "end"]);
+    let scene = morphfx::scene::Scene::read(&inst.string("scene_text").unwrap()).unwrap();
+    let edge = &scene.features[0];
+    assert_eq!(
+        (edge.kind.name(), edge.a.len()),
+        ("curve", 3),
+        "control points kept"
+    );
+    for (points, x) in [(&edge.a, 24.0), (&edge.b, 36.0)] {
+        for p in points.iter() {
+            assert!((p.x - x).abs() < 0.5, "{p:?} onto x = {x}");
+        }
+    }
+    assert_eq!(
+        scene.features[1],
+        morphfx::scene::Scene::read(text).unwrap().features[1]
+    );
+}

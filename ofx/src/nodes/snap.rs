@@ -1,13 +1,15 @@
-//! The Snap Lines push-button (Lee, Wolberg et al. §4.2): every enabled line slot slides
-//! onto the nearest strong edge of its source at the current frame — A
-//! positions on Source A, B positions on Source B (Morph) — and the moved
-//! endpoints are keyed there, so the user places lines roughly and lets the
-//! image finish the job.
+//! The Snap Lines push-button (Lee, Wolberg et al. §4.2): every enabled line slot, and
+//! every line, polyline and curve of Scene Text, slides onto the nearest
+//! strong edge of its source at the current frame — A positions on Source
+//! A, B positions on Source B (Morph) — and the moved points are keyed
+//! there (slots in their params, shapes in Scene Text, one undo step), so
+//! the user places features roughly and lets the image finish the job.
 
-use morphfx::features::FeatureKind;
+use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::{PixelScale, Vec2};
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 
+use super::overlay::shapes;
 use super::params::{slot_ids, Reader, Settings, SlotIds, LINE_COUNT, SNAP_SIGMA};
 use super::NodeState;
 use crate::wrapper::clips::{Depth, EffectHandle};
@@ -50,9 +52,31 @@ pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
             keys.extend([(start, p), (end, q)]);
         }
     }
+    // Scene Text's shapes, when the viewer may edit them.
+    let mut doc = shapes::document(instance, time)
+        .ok()
+        .filter(|d| d.scene().has_features());
+    if let Some(doc) = doc.as_mut() {
+        let energies =
+            std::iter::once((Side::A, &energy_a)).chain(energy_b.as_ref().map(|e| (Side::B, e)));
+        let mut moved = Vec::new();
+        let features = doc.scene().features_at(time);
+        for (side, (energy, scale)) in energies {
+            for (i, f) in features.iter().enumerate() {
+                if let Some(points) = snap_shape(f, side, energy, *scale) {
+                    moved.push((time, i, side, points));
+                }
+            }
+        }
+        doc.set_points(&moved).map_err(shapes::refused)?;
+    }
     params.edit_block("Snap Lines", || {
         keys.iter()
-            .try_for_each(|(id, p)| params.set_point_at(id.name(), time, (p.x, p.y)))
+            .try_for_each(|(id, p)| params.set_point_at(id.name(), time, (p.x, p.y)))?;
+        match &doc {
+            Some(doc) => shapes::write(instance, doc),
+            None => Ok(()),
+        }
     })?;
     instance.purge();
     Ok(())
@@ -73,6 +97,36 @@ fn snap_line(line: [Vec2; 2], energy: &EdgeEnergy, scale: PixelScale) -> [Vec2; 
     } else {
         line
     }
+}
+
+/// Feature `f`'s control points on `side` (canonical) snaked on `energy`
+/// and unsnaked; `None` for points, and for a result that is not finite.
+/// A closed shape is snaked with its closing span and its first point
+/// taken where the snake's start left it.
+fn snap_shape(
+    f: &Feature,
+    side: Side,
+    energy: &EdgeEnergy,
+    scale: PixelScale,
+) -> Option<Vec<Vec2>> {
+    let kind = match f.kind {
+        FeatureKind::Point => return None,
+        FeatureKind::Line => FeatureKind::Polyline,
+        k => k,
+    };
+    let mut px: Vec<Vec2> = f.points(side).iter().map(|p| scale.to_pixel(*p)).collect();
+    let n = px.len();
+    if f.closed {
+        px.push(px[0]);
+    }
+    let settings = SnakeSettings::default();
+    let mut snake = Snake::from_primitive(kind, &px, &settings);
+    snake.run(energy, &settings);
+    let back: Vec<Vec2> = snake.unsnake()[..n]
+        .iter()
+        .map(|p| Vec2::new(p.x / scale.x, p.y / scale.y))
+        .collect();
+    back.iter().all(|p| p.is_finite()).then_some(back)
 }
 
 /// The edge energy of clip `name` at `time`, and the pixel scale it is in.
