@@ -447,3 +447,71 @@ fn a_scene_text_that_is_not_a_scene_is_drawn_as_nothing_and_never_overwritten() 
     assert_eq!(scene(&inst).features.len(), 1);
     assert_eq!(inst.persistent_message(), None);
 }
+
+/// `morphfx overlay` draws a scene's shapes over the plate as the node
+/// draws them: a closed curve all the way round.
+#[test]
+fn morphfx_overlay_draws_closed_curves_of_a_scene() {
+    let dir = common::scratch("overlay-shapes-cli");
+    let (a, b, out, scene_path) = (
+        dir.join("a.exr"),
+        dir.join("b.exr"),
+        dir.join("out.exr"),
+        dir.join("ring.morph.json"),
+    );
+    let grey = |_| [0.2f32, 0.2, 0.2];
+    let plate = common::colour_plate(&a, 120, 80, grey);
+    common::colour_plate(&b, 120, 80, grey);
+    let ring =
+        [(85.0, 40.0), (60.0, 65.0), (35.0, 40.0), (60.0, 15.0)].map(|(x, y)| Vec2::new(x, y));
+    let pts: Vec<String> = ring.iter().map(|p| format!("[{}, {}]", p.x, p.y)).collect();
+    let pts = pts.join(", ");
+    std::fs::write(
+        &scene_path,
+        format!(
+            r#"{{"format": "morphfx-scene", "version": 1, "features": [
+                {{"name": "ring", "type": "curve", "closed": true, "a": [{pts}], "b": [{pts}]}}]}}"#
+        ),
+    )
+    .unwrap();
+    let s = |p: &std::path::Path| p.to_string_lossy().into_owned();
+    let run = common::run_morphfx(&[
+        "overlay",
+        "--scene",
+        &s(&scene_path),
+        "--a",
+        &s(&a),
+        "--b",
+        &s(&b),
+        "--show",
+        "a",
+        "-o",
+        &s(&out),
+        "--float",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let drawn = morphfx_harness::io::read(&out).unwrap().image;
+    // Orange (red well above blue) within a pixel of `p` (canonical, y up).
+    let orange_near = |p: Vec2| {
+        let (i, j) = (p.x.floor() as i32, p.y.floor() as i32);
+        (-1..=1).any(|dj| {
+            (-1..=1).any(|di| {
+                let px = drawn.pixel(i + di, j + dj);
+                px[0] - px[2] > 0.4
+            })
+        })
+    };
+    // Halfway along every span, the closing one (from the last point back
+    // to the first) included.
+    for span in 0..4 {
+        let mid = morphfx::features::catmull_rom_closed(&ring, span, 0.5);
+        assert!(orange_near(mid), "span {span} at {mid:?}");
+    }
+    // Inside the ring and outside it: the plate.
+    assert_eq!(drawn.pixel(60, 40), plate.pixel(60, 40));
+    assert_eq!(drawn.pixel(5, 5), plate.pixel(5, 5));
+}

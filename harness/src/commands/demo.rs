@@ -209,7 +209,7 @@ pub fn demo_scene((cx, cy): (f64, f64)) -> serde_json::Value {
         ([cx + 90.0 * c, cy + 90.0 * s], [cx + r * c, cy + r * s])
     };
     let (outline_a, outline_b): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
-        (0..=OUTLINE_SEGMENTS).map(ray).unzip();
+        (0..OUTLINE_SEGMENTS).map(ray).unzip();
     let across = |(x, y): (f64, f64), half: f64| [[cx + x - half, cy + y], [cx + x + half, cy + y]];
     serde_json::json!({
         "format": "morphfx-scene", "version": 1, "method": "field",
@@ -218,7 +218,7 @@ pub fn demo_scene((cx, cy): (f64, f64)) -> serde_json::Value {
             { "name": "left eye", "type": "line", "a": across((-30.0, 25.0), 9.0), "b": across((-35.0, 35.0), 9.0) },
             { "name": "right eye", "type": "line", "a": across((30.0, 25.0), 9.0), "b": across((35.0, 35.0), 9.0) },
             { "name": "mouth", "type": "line", "a": across((0.0, -35.0), 35.0), "b": across((0.0, -40.0), 45.0) },
-            { "name": "outline", "type": "polyline", "a": outline_a, "b": outline_b }
+            { "name": "outline", "type": "polyline", "closed": true, "a": outline_a, "b": outline_b }
         ],
         "progress": [[1, 0.0], [12, 1.0]]
     })

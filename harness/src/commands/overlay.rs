@@ -64,6 +64,13 @@ impl Job {
         let bundle = Bundle::load_with(bundle_path, options)?;
         let inst = bundle.instance(self.plugin, self.context)?;
         self.set_up(&inst, &job)?;
+        if self.common.scene.is_some() {
+            // As a compositor does to edit a scene file's shapes: they are
+            // then drawn as the node draws shapes it owns (control points
+            // marked, full strength) rather than dimmed.
+            let first = job.frames.first().copied().unwrap_or(0) as f64;
+            inst.instance_changed("copy_scene", first)?;
+        }
         self.draw_overlays(&inst, &job, show)
     }
 
