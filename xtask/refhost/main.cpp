@@ -437,6 +437,44 @@ void checkOverlayGl(Effect &fx, const Where &w) {
   }
 }
 
+/// Scene Text's shapes edited through the library's own overlay interact:
+/// a drag moves one control point of a curve, and the point tool adds a
+/// point feature, each written back into the String param this host gives
+/// storage; the numbers read back are where the pen let go.
+void checkOverlayShapes(Effect &fx, const Where &w) {
+  auto *text = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_text"));
+  auto *tool = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("draw_tool"));
+  if (!text || !tool) return fail(w.text + ": no scene_text or draw_tool param");
+  text->set(
+      "{\"format\": \"morphfx-scene\", \"version\": 1, \"features\": [{\"name\": \"brow\", "
+      "\"type\": \"curve\", \"a\": [[40, 40], [50, 45], [60, 40]], "
+      "\"b\": [[40, 42], [50, 48], [60, 42]]}]}");
+  Overlay ov(fx);
+  expectOk(ov.createInstanceAction(), w, "overlay createInstance");
+  const OfxPointD scale = {1, 1};
+  const OfxPointI vp = {0, 0};
+  expectOk(ov.drawAction(0, scale), w, "overlay draw");
+  const OfxPointD from = {50, 45}, mid = {51, 46}, to = {52.5, 47};
+  expectOk(ov.penDownAction(0, scale, from, vp, 1), w, "overlay pen down on the curve");
+  expectOk(ov.penMotionAction(0, scale, mid, vp, 1), w, "overlay pen motion");
+  expectOk(ov.penUpAction(0, scale, to, vp, 0), w, "overlay pen up");
+  std::string after;
+  text->get(after);
+  auto has = [&](const char *s) { return after.find(s) != std::string::npos; };
+  if (!has("[52.5, 47]") || has("[50, 45]") || !has("[40, 40]") || !has("[60, 40]") ||
+      !has("[50, 48]"))
+    fail(w.text + ": dragging the curve's middle A point to (52.5, 47) left Scene Text " +
+         after);
+  tool->set(1);  // point
+  const OfxPointD empty = {85, 55};
+  expectOk(ov.penDownAction(0, scale, empty, vp, 1), w, "overlay pen down (point tool)");
+  expectOk(ov.penUpAction(0, scale, empty, vp, 0), w, "overlay pen up (point tool)");
+  text->get(after);
+  if (!has("\"type\": \"point\"") || !has("\"a\": [[85, 55]]") || !has("\"b\": [[85, 55]]"))
+    fail(w.text + ": the point tool's click at (85, 55) left Scene Text " + after);
+  tool->set(0);
+}
+
 /// Track Forward through the library, before any render: images fetched in
 /// instanceChanged, the progress suite, keys set at other times. The
 /// sources do not move from frame to frame, so B's line, which lies on
@@ -582,6 +620,8 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
     checkFailureMessage(*fx, w.with("missing scene file"));
     checkOverlay(*fx, w.with("overlay"));
     checkOverlayGl(*fx, w.with("overlay in OpenGL"));
+    checkOverlayShapes(*fx, w.with("overlay shapes"));
+    loadScene(*fx, w);
     if (inputClips(*fx).size() == 2) checkTrack(*fx, w.with("track"));
     checkMattes(*fx, w.with("mattes"));
   }
