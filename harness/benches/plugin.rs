@@ -3,6 +3,9 @@
 //! method. The plugin's path adds the host's images, the param reads, the
 //! cache and the copies; this says what they cost.
 //!
+//! The overlay: 60 shapes of 20 points each in Scene Text drawn through
+//! the Draw suite, hovered and dragged, against parsing the same text.
+//!
 //! `cargo xtask bundle --release && cargo bench -p morphfx-harness --bench plugin`
 
 use std::hint::black_box;
@@ -18,7 +21,9 @@ use morphfx::image::{EdgeMode, Filter, Image, Sampler};
 use morphfx::make_warp::{toward, MethodSettings, WarpSettings};
 use morphfx::morph::{dissolve, Warped};
 use morphfx::testing::Lcg;
-use morphfx_harness::host::{Bundle, Frame, FrameSource, OutputSpec};
+use morphfx_harness::host::overlay::Overlay;
+use morphfx_harness::host::{Bundle, Frame, FrameSource, HostOptions, OutputSpec};
+use openfx::sys::image_effect_v1::interact::*;
 
 const W: usize = 1920;
 const H: usize = 1080;
@@ -140,5 +145,78 @@ fn bench_plugin_path(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_plugin_path);
+/// 60 curves and polylines of 20 points each (every third closed) spread
+/// over a 1080p frame, B a little off A.
+fn shapes_json() -> String {
+    let mut r = Lcg::new(60);
+    let shapes: Vec<serde_json::Value> = (0..60)
+        .map(|k| {
+            let c = Vec2::new(r.range(150.0, W as f64 - 150.0), r.range(150.0, H as f64 - 150.0));
+            let radius = r.range(30.0, 120.0);
+            let a: Vec<[f64; 2]> = (0..20)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * i as f64 / 20.0;
+                    [c.x + radius * t.cos(), c.y + radius * 0.7 * t.sin()]
+                })
+                .collect();
+            let b: Vec<[f64; 2]> = a.iter().map(|p| [p[0] + 6.0, p[1] - 4.0]).collect();
+            let kind = if k % 2 == 0 { "curve" } else { "polyline" };
+            serde_json::json!({"name": format!("s{k}"), "type": kind, "closed": k % 3 == 0, "a": a, "b": b})
+        })
+        .collect();
+    serde_json::json!({"format": "morphfx-scene", "version": 1, "features": shapes}).to_string()
+}
+
+fn bench_overlay(c: &mut Criterion) {
+    let text = shapes_json();
+    let mut g = c.benchmark_group("overlay_60_shapes_x20_points");
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    g.bench_function("peer_parse_scene_text_json", |bch| {
+        bch.iter(|| black_box(serde_json::from_str::<serde_json::Value>(&text).unwrap()))
+    });
+    let options = HostOptions {
+        overlays: true,
+        draw_suite: true,
+    };
+    let bundle = Bundle::load_with(&bundle_path(), options).expect("the bundle");
+    let inst = bundle
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    inst.set_project(W as f64, H as f64);
+    inst.set_string("scene_text", &text).unwrap();
+    let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
+    g.bench_function("draw", |bch| {
+        bch.iter(|| black_box(ov.draw(1.0, (1.0, 1.0)).unwrap()))
+    });
+    g.bench_function("hover_motion", |bch| {
+        bch.iter(|| {
+            ov.pen(kOfxInteractActionPenMotion, 1.0, (960.0, 540.0), (1.0, 1.0))
+                .unwrap()
+        })
+    });
+    // A drag of one control point: each motion edits and writes Scene
+    // Text, then the viewer redraws (the scene parsed afresh).
+    let start = {
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let p = &v["features"][0]["a"][0];
+        (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
+    };
+    ov.pen(kOfxInteractActionPenDown, 1.0, start, (1.0, 1.0))
+        .unwrap();
+    let mut k = 0.0;
+    g.bench_function("drag_motion_and_redraw", |bch| {
+        bch.iter(|| {
+            k += 0.01;
+            let at = (start.0 + k, start.1);
+            ov.pen(kOfxInteractActionPenMotion, 1.0, at, (1.0, 1.0))
+                .unwrap();
+            black_box(ov.draw(1.0, (1.0, 1.0)).unwrap())
+        })
+    });
+    ov.pen(kOfxInteractActionPenUp, 1.0, start, (1.0, 1.0))
+        .unwrap();
+    g.finish();
+}
+
+criterion_group!(benches, bench_plugin_path, bench_overlay);
 criterion_main!(benches);
