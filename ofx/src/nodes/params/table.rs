@@ -94,9 +94,9 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(TRANSITION_CYCLES, "Cycles", "Sinusoid periods across the frame (sine patterns), or rings (radial; 0: the centre first, then outward).", Kind::Double { default: 2.0, min: 0.0, max: 100.0, display: (0.0, 8.0) }).in_group("transition_group"),
         ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
         ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
-        ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved endpoints there. Place lines roughly, then press.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line, and every line, polyline and curve of Scene Text, onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved points there. Place features roughly, then press.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(SNAP_SIGMA, "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Kind::Double { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group("lines_group").animated(false),
-        ParamSpec::new(TRACK_FORWARD, "Track Forward", "Follows every enabled line through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", Kind::Button).in_group("lines_group"),
+        ParamSpec::new(TRACK_FORWARD, "Track Forward", "Follows every enabled line, and every control point of Scene Text's shapes, through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(TRACK_BACKWARD, "Track Backward", "As Track Forward, towards the start: to the previous key, or the first frame of the clip.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(OVERLAY_SHOW, "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", choice(Show::Both)).in_group("lines_group").animated(false),
         ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which features the pen moves in the viewer (line slots and the shapes of Scene Text). Drag a point, or a feature by its body. Hold Shift to grab only A's, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
@@ -129,7 +129,7 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(
             SCENE_TEXT,
             "Scene Text",
-            "A scene as JSON text (used when Scene File is empty).",
+            "A scene as JSON text (used when Scene File is empty). The viewer draws its shapes and edits them in place.",
             Kind::Text {
                 default: "",
                 mode: TextMode::MultiLine,
