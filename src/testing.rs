@@ -275,3 +275,44 @@ pub fn corners(image: &Image, n: usize, gap: f64, margin: f64) -> Vec<Vec2> {
     }
     picked
 }
+
+/// The numbers of JSON document `after` that differ from `before`'s, with
+/// their paths (`.features[1].b[1][0]`) and both values. Refuses two
+/// documents whose numbers sit at different paths: an edit that was meant
+/// to change values only must not move anything.
+pub fn changed_numbers(before: &str, after: &str) -> Vec<(String, f64, f64)> {
+    fn numbers(v: &serde_json::Value, path: String, out: &mut Vec<(String, f64)>) {
+        match v {
+            serde_json::Value::Number(n) => out.push((path, n.as_f64().unwrap_or(f64::NAN))),
+            serde_json::Value::Array(items) => {
+                for (i, v) in items.iter().enumerate() {
+                    numbers(v, format!("{path}[{i}]"), out);
+                }
+            }
+            serde_json::Value::Object(o) => {
+                for (k, v) in o {
+                    numbers(v, format!("{path}.{k}"), out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let read = |text: &str| {
+        let mut out = Vec::new();
+        let v = serde_json::from_str(text).expect("both documents are JSON");
+        numbers(&v, String::new(), &mut out);
+        out
+    };
+    let (x, y) = (read(before), read(after));
+    let paths = |v: &[(String, f64)]| v.iter().map(|p| p.0.clone()).collect::<Vec<_>>();
+    assert_eq!(
+        paths(&x),
+        paths(&y),
+        "the documents' numbers sit at the same paths"
+    );
+    x.into_iter()
+        .zip(y)
+        .filter(|(p, q)| p.1 != q.1)
+        .map(|(p, q)| (q.0, p.1, q.1))
+        .collect()
+}

@@ -3,27 +3,14 @@
 
 mod common;
 
-use std::sync::OnceLock;
-
 use morphfx_harness::host::overlay::{Answer, DrawCall, Overlay};
 use morphfx_harness::host::params::take_edit_log;
-use morphfx_harness::host::{take_violations, Bundle, HostOptions, Instance};
+use morphfx_harness::host::{take_violations, Instance};
 use openfx::sys::image_effect_v1::draw_suite::*;
 use openfx::sys::image_effect_v1::interact::*;
 
-fn bundle() -> &'static Bundle {
-    static B: OnceLock<Bundle> = OnceLock::new();
-    B.get_or_init(|| {
-        let options = HostOptions {
-            overlays: true,
-            draw_suite: true,
-        };
-        Bundle::load_with(&common::bundle_path(), options).expect("the bundle loads")
-    })
-}
-
 fn morph() -> Instance<'static> {
-    bundle()
+    common::overlay_bundle()
         .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
         .unwrap()
 }
@@ -54,9 +41,7 @@ fn two_lines(inst: &Instance<'_>) {
 }
 
 fn overlay<'i>(inst: &'i Instance<'i>) -> Overlay<'i> {
-    Overlay::new(inst, true)
-        .unwrap()
-        .expect("the node declares an overlay")
+    common::overlay(inst)
 }
 
 /// Every segment drawn (pairs of `Lines` draws), in the colour pass (the

@@ -4,39 +4,24 @@
 
 mod common;
 
-use std::sync::OnceLock;
-
 use morphfx::features::{catmull_rom, FeatureKind};
 use morphfx::geom::Vec2;
 use morphfx::scene::Scene;
+use morphfx::testing::changed_numbers;
 use morphfx_harness::host::overlay::{Answer, DrawCall, Overlay};
 use morphfx_harness::host::params::take_edit_log;
-use morphfx_harness::host::{take_violations, Bundle, HostOptions, Instance};
+use morphfx_harness::host::{take_violations, Instance};
 use openfx::sys::image_effect_v1::draw_suite::*;
 use openfx::sys::image_effect_v1::interact::*;
-use serde_json::Value;
-
-fn bundle() -> &'static Bundle {
-    static B: OnceLock<Bundle> = OnceLock::new();
-    B.get_or_init(|| {
-        let options = HostOptions {
-            overlays: true,
-            draw_suite: true,
-        };
-        Bundle::load_with(&common::bundle_path(), options).expect("the bundle loads")
-    })
-}
 
 fn morph() -> Instance<'static> {
-    bundle()
+    common::overlay_bundle()
         .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
         .unwrap()
 }
 
 fn overlay<'i>(inst: &'i Instance<'i>) -> Overlay<'i> {
-    Overlay::new(inst, true)
-        .unwrap()
-        .expect("the node declares an overlay")
+    common::overlay(inst)
 }
 
 const PX: (f64, f64) = (1.0, 1.0);
@@ -65,42 +50,11 @@ fn scene(inst: &Instance<'_>) -> Scene {
     Scene::read(&scene_text(inst)).expect("Scene Text stays a valid scene")
 }
 
-/// Every number in a JSON document, with its path.
-fn numbers(v: &Value, path: String, out: &mut Vec<(String, f64)>) {
-    match v {
-        Value::Number(n) => out.push((path, n.as_f64().unwrap())),
-        Value::Array(items) => {
-            for (i, v) in items.iter().enumerate() {
-                numbers(v, format!("{path}[{i}]"), out);
-            }
-        }
-        Value::Object(o) => {
-            for (k, v) in o {
-                numbers(v, format!("{path}.{k}"), out);
-            }
-        }
-        _ => {}
-    }
-}
-
-/// The numbers of `after` that differ from `before`'s (same layout).
+/// The numbers of `after` that differ from `before`'s: paths and new values.
 fn changed(before: &str, after: &str) -> Vec<(String, f64)> {
-    let (mut x, mut y) = (Vec::new(), Vec::new());
-    numbers(
-        &serde_json::from_str(before).unwrap(),
-        String::new(),
-        &mut x,
-    );
-    numbers(&serde_json::from_str(after).unwrap(), String::new(), &mut y);
-    assert_eq!(
-        x.iter().map(|p| &p.0).collect::<Vec<_>>(),
-        y.iter().map(|p| &p.0).collect::<Vec<_>>(),
-        "same layout"
-    );
-    x.into_iter()
-        .zip(y)
-        .filter(|(p, q)| p.1 != q.1)
-        .map(|(_, q)| q)
+    changed_numbers(before, after)
+        .into_iter()
+        .map(|(path, _, now)| (path, now))
         .collect()
 }
 
@@ -221,13 +175,17 @@ fn in_a_keyed_scene_a_drag_keys_its_frame_and_leaves_the_other_keys() {
     let inst = morph();
     inst.set_string("scene_text", KEYED).unwrap();
     let ov = overlay(&inst);
-    // At frame 10 the key exists: only its number moves.
+    // At frame 10 the key exists: only its number moves, in one edit block.
     let before = scene_text(&inst);
+    take_edit_log();
     ov.drag(10.0, (150.0, 150.5), (150.0, 160.0), PX).unwrap();
     assert_eq!(
         changed(&before, &scene_text(&inst)),
         [(".keyframes[1].features[0].a[1][1]".to_owned(), 160.0)]
     );
+    let log = take_edit_log();
+    assert_eq!(log.iter().filter(|l| l.starts_with("begin")).count(), 1);
+    assert_eq!(log.last().map(String::as_str), Some("end"));
     // At frame 5 there is none: one is made from the interpolated lip
     // (A's middle at (150, 145)), then edited; the keys at 0 and 10 stay.
     ov.drag(5.0, (150.0, 145.0), (170.0, 145.0), PX).unwrap();
@@ -287,11 +245,19 @@ fn polylines_close_on_their_first_point_and_curves_end_open() {
     for at in [(10.0, 10.0), (90.0, 10.0), (50.0, 70.0)] {
         ov.click(0.0, at, PX).unwrap();
     }
-    // Drawn so far, before it is closed: the points joined.
+    // Drawn so far, before it is closed: the points joined, and a dashed
+    // rubber band from the last one to the pen.
+    ov.pen(kOfxInteractActionPenMotion, 0.0, (30.0, 40.0), PX)
+        .unwrap();
     let calls = ov.draw(0.0, PX).unwrap();
     assert!(strips_in(&calls, A_COLOUR)
         .iter()
         .any(|s| s[..] == [[10.0, 10.0], [90.0, 10.0], [50.0, 70.0]]));
+    let band = calls.windows(2).any(|w| {
+        matches!(&w[1], DrawCall::Draw { primitive, points }
+            if *primitive == kOfxDrawPrimitiveLines && points[..] == [[50.0, 70.0], [30.0, 40.0]])
+    });
+    assert!(band, "the rubber band");
     ov.click(0.0, (12.0, 11.0), PX).unwrap();
     let s = scene(&inst);
     assert_eq!(s.features.len(), 1);
@@ -301,6 +267,28 @@ fn polylines_close_on_their_first_point_and_curves_end_open() {
         (FeatureKind::Polyline, true, 3)
     );
     assert_eq!(tri.a, tri.b, "new shapes start with B on A");
+    // A curve closes the same way.
+    inst.set_choice("draw_tool", "curve").unwrap();
+    for at in [
+        (500.0, 100.0),
+        (600.0, 100.0),
+        (550.0, 180.0),
+        (502.0, 99.0),
+    ] {
+        ov.click(0.0, at, PX).unwrap();
+    }
+    let s = scene(&inst);
+    let loop_ = &s.features[1];
+    assert_eq!(
+        (loop_.kind, loop_.closed, loop_.a.len()),
+        (FeatureKind::Curve, true, 3)
+    );
+    inst.instance_changed("delete_shape", 0.0).unwrap();
+    assert_eq!(
+        scene(&inst).features.len(),
+        1,
+        "Delete Shape: the curve just drawn"
+    );
     // A curve: three clicks, then a second click on the last point ends it
     // open; then another by Return, and a third by the Finish Shape button.
     inst.set_choice("draw_tool", "curve").unwrap();

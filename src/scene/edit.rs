@@ -136,16 +136,10 @@ impl Document {
     /// at every key: the next point of a shape being drawn.
     pub fn append_point(&mut self, feature: usize, p: Vec2) -> Result<()> {
         self.edit(|doc| {
-            for list in doc.lists()? {
-                let f = list
-                    .get_mut(feature)
-                    .ok_or_else(|| missing(feature, "it"))?;
-                for side in [Side::A, Side::B] {
-                    side_points(f, side)?.push(point_json(p));
-                }
-                forget_track(f);
-            }
-            Ok(())
+            doc.each_key(feature, |points| {
+                points.push(point_json(p));
+                Ok(())
+            })
         })
     }
 
@@ -198,16 +192,13 @@ impl Document {
             return Ok(true);
         }
         self.edit(|doc| {
-            for list in doc.lists()? {
-                let f = list
-                    .get_mut(feature)
-                    .ok_or_else(|| missing(feature, "it"))?;
-                for side in [Side::A, Side::B] {
-                    side_points(f, side)?.remove(index);
+            doc.each_key(feature, |points| {
+                if index >= points.len() {
+                    return Err(missing(feature, &format!("point {index}")));
                 }
-                forget_track(f);
-            }
-            Ok(())
+                points.remove(index);
+                Ok(())
+            })
         })?;
         Ok(false)
     }
@@ -276,6 +267,25 @@ impl Editor<'_> {
             .get("keyframes")
             .and_then(Value::as_array)
             .is_some_and(|k| !k.is_empty())
+    }
+
+    /// Applies `change` to feature `feature`'s point list on A and on B in
+    /// every key (its point count changes: tracking flags go).
+    fn each_key(
+        &mut self,
+        feature: usize,
+        mut change: impl FnMut(&mut Vec<Value>) -> Result<()>,
+    ) -> Result<()> {
+        for list in self.lists()? {
+            let f = list
+                .get_mut(feature)
+                .ok_or_else(|| missing(feature, "it"))?;
+            for side in [Side::A, Side::B] {
+                change(side_points(f, side)?)?;
+            }
+            forget_track(f);
+        }
+        Ok(())
     }
 
     /// Every feature list: each keyframe's, or the static one.

@@ -3,6 +3,7 @@ use serde_json::Value;
 use super::edit::Document;
 use crate::features::{Feature, FeatureKind, Side};
 use crate::geom::Vec2;
+use crate::testing::changed_numbers;
 
 const STATIC: &str = r#"{
   "format": "morphfx-scene", "version": 1, "method": "field",
@@ -21,41 +22,6 @@ const KEYED: &str = r#"{"keyframes": [
   {"frame": 20, "features": [{"name": "eye", "type": "polyline", "a": [[10,0],[20,0],[20,10]], "b": [[0,0],[10,0],[10,10]]}]}
 ]}"#;
 
-/// Every number in `v`, with its JSON path.
-fn numbers(v: &Value, path: String, out: &mut Vec<(String, f64)>) {
-    match v {
-        Value::Number(n) => out.push((path, n.as_f64().unwrap())),
-        Value::Array(items) => {
-            for (i, v) in items.iter().enumerate() {
-                numbers(v, format!("{path}[{i}]"), out);
-            }
-        }
-        Value::Object(o) => {
-            for (k, v) in o {
-                numbers(v, format!("{path}.{k}"), out);
-            }
-        }
-        _ => {}
-    }
-}
-
-/// The numbers that differ between two documents of the same layout.
-fn changed(before: &str, after: &str) -> Vec<(String, f64, f64)> {
-    let (mut x, mut y) = (Vec::new(), Vec::new());
-    numbers(
-        &serde_json::from_str(before).unwrap(),
-        String::new(),
-        &mut x,
-    );
-    numbers(&serde_json::from_str(after).unwrap(), String::new(), &mut y);
-    assert_eq!(x.len(), y.len(), "same layout");
-    x.into_iter()
-        .zip(y)
-        .filter(|(p, q)| p.1 != q.1 || p.0 != q.0)
-        .map(|(p, q)| (q.0, p.1, q.1))
-        .collect()
-}
-
 #[test]
 fn moving_one_point_changes_exactly_that_number_pair_and_keeps_key_order() {
     let mut d = Document::parse(STATIC).unwrap();
@@ -63,7 +29,7 @@ fn moving_one_point_changes_exactly_that_number_pair_and_keeps_key_order() {
         .unwrap();
     let text = d.text();
     assert_eq!(
-        changed(STATIC, &text),
+        changed_numbers(STATIC, &text),
         [
             (".features[1].b[1][0]".into(), 340.0, 345.25),
             (".features[1].b[1][1]".into(), 190.0, 187.0)

@@ -164,3 +164,28 @@ pub fn pyramids(
 pub fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
+
+/// The bundle loaded once per test binary in a host with overlays and the
+/// Draw suite.
+#[allow(dead_code)] // the overlay tests only
+pub fn overlay_bundle() -> &'static morphfx_harness::host::Bundle {
+    use morphfx_harness::host::{Bundle, HostOptions};
+    static B: std::sync::OnceLock<Bundle> = std::sync::OnceLock::new();
+    B.get_or_init(|| {
+        let options = HostOptions {
+            overlays: true,
+            draw_suite: true,
+        };
+        Bundle::load_with(&bundle_path(), options).expect("the bundle loads")
+    })
+}
+
+/// `inst`'s overlay, drawn through the Draw suite.
+#[allow(dead_code)] // the overlay tests only
+pub fn overlay<'i>(
+    inst: &'i morphfx_harness::host::Instance<'i>,
+) -> morphfx_harness::host::overlay::Overlay<'i> {
+    morphfx_harness::host::overlay::Overlay::new(inst, true)
+        .unwrap()
+        .expect("the node declares an overlay")
+}

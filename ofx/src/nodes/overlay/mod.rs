@@ -89,6 +89,8 @@ struct Building {
     points: Vec<Vec2>,
     /// Its index in Scene Text once it has two points (and is written).
     feature: Option<usize>,
+    /// Where the pen last hovered: the next point's rubber band runs there.
+    cursor: Option<Vec2>,
 }
 
 /// Shortest new line kept, in screen pixels: a click is not a line.
@@ -227,7 +229,10 @@ fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Out
         .collect();
     let (hover, building) = {
         let state = lock(&instance.overlay);
-        let building = state.building.as_ref().map(|b| b.points.clone());
+        let building = state
+            .building
+            .as_ref()
+            .map(|b| (b.points.clone(), b.cursor));
         (state.hover, building.unwrap_or_default())
     };
     paint::paint(
@@ -239,7 +244,7 @@ fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Out
             hover,
             pixel,
             keys: (&v.keys, time),
-            building: &building,
+            building: (&building.0, building.1),
         },
     );
     Ok(Reply::Done)

@@ -24,8 +24,9 @@ pub struct Frame<'a> {
     pub pixel: (f64, f64),
     /// The frames the scene's shapes are keyed at, and the draw's time.
     pub keys: (&'a [f64], f64),
-    /// The control points of a polyline or curve being drawn.
-    pub building: &'a [Vec2],
+    /// The control points of a polyline or curve being drawn, and where
+    /// the pen is (the next point's rubber band runs there).
+    pub building: (&'a [Vec2], Option<Vec2>),
 }
 
 /// A's features.
@@ -235,11 +236,18 @@ impl Pen<'_> {
     }
 
     /// The control points of a polyline or curve being drawn, joined, the
-    /// first one marked larger (a click there closes the shape).
-    fn building(&mut self, points: &[Vec2]) {
-        let Some(first) = points.first() else {
+    /// first one marked larger (a click there closes the shape), and a
+    /// dashed rubber band from the last one to the pen.
+    fn building(&mut self, (points, cursor): (&[Vec2], Option<Vec2>)) {
+        let (Some(first), Some(last)) = (points.first(), points.last()) else {
             return;
         };
+        if let Some(c) = cursor {
+            self.painter.stipple(Stipple::Dash);
+            self.painter.width(1.0);
+            self.colour(A_COLOUR, 0.8);
+            self.segment([*last, c]);
+        }
         self.painter.stipple(Stipple::Solid);
         self.painter.width(1.5);
         self.colour(A_COLOUR, 1.0);

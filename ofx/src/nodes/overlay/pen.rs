@@ -254,7 +254,14 @@ pub fn motion(
     let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
     let outlines = view(instance, pen.time).outlines;
     let hover = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
-    let building = state.building.is_some();
+    // While a shape is drawn, every motion moves its rubber band.
+    let building = match state.building.as_mut() {
+        Some(b) => {
+            b.cursor = Some(pen.at);
+            true
+        }
+        None => false,
+    };
     if hover != state.hover || building {
         state.hover = hover;
         drop(state);
@@ -327,6 +334,7 @@ fn start_building(
         kind,
         points: vec![pen.at],
         feature: None,
+        cursor: None,
     });
     Ok(Reply::Done)
 }
