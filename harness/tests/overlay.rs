@@ -58,15 +58,7 @@ fn segments(calls: &[DrawCall]) -> Vec<[[f64; 2]; 2]> {
     out
 }
 
-fn texts(calls: &[DrawCall]) -> Vec<String> {
-    calls
-        .iter()
-        .filter_map(|c| match c {
-            DrawCall::Text { text, .. } => Some(text.clone()),
-            _ => None,
-        })
-        .collect()
-}
+use common::texts;
 
 #[test]
 fn draw_shows_every_enabled_line_at_its_values_at_the_time_with_labels() {

@@ -76,15 +76,7 @@ fn strips_in(calls: &[DrawCall], rgb: [f32; 3]) -> Vec<Vec<[f64; 2]>> {
     out
 }
 
-fn texts(calls: &[DrawCall]) -> Vec<String> {
-    calls
-        .iter()
-        .filter_map(|c| match c {
-            DrawCall::Text { text, .. } => Some(text.clone()),
-            _ => None,
-        })
-        .collect()
-}
+use common::texts;
 
 const A_COLOUR: [f32; 3] = [1.0, 0.55, 0.1];
 const B_COLOUR: [f32; 3] = [0.25, 0.8, 1.0];

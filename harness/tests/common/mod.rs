@@ -189,3 +189,16 @@ pub fn overlay<'i>(
         .unwrap()
         .expect("the node declares an overlay")
 }
+
+/// The labels an overlay drew, in order.
+#[allow(dead_code)] // the overlay tests only
+pub fn texts(calls: &[morphfx_harness::host::overlay::DrawCall]) -> Vec<String> {
+    use morphfx_harness::host::overlay::DrawCall;
+    calls
+        .iter()
+        .filter_map(|c| match c {
+            DrawCall::Text { text, .. } => Some(text.clone()),
+            _ => None,
+        })
+        .collect()
+}
