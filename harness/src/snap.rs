@@ -80,8 +80,14 @@ impl Snap<'_> {
                 continue;
             }
             let kind = kind.expect("checked above");
+            let closed = f.get("closed").and_then(Value::as_bool) == Some(true);
             let mut side = |key: &str, energy: &EdgeEnergy| -> Vec<Vec2> {
-                let controls = points(&f[key]);
+                let mut controls = points(&f[key]);
+                // A closed shape is snaked with its closing span, and stays
+                // closed: the snake's second visit of the first point goes.
+                if closed {
+                    controls.extend(controls.first().copied());
+                }
                 let mut snake = Snake::from_primitive(kind, &controls, &self.settings);
                 let before = snake.points.clone();
                 snake.run(energy, &self.settings);
@@ -90,6 +96,9 @@ impl Snap<'_> {
                     .zip(&snake.points)
                     .map(|(a, b)| a.distance(*b))
                     .fold(moved, f64::max);
+                if closed {
+                    snake.points.pop();
+                }
                 snake.points
             };
             let (a, b) = (side("a", &energy_a), side("b", &energy_b));

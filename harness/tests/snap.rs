@@ -123,3 +123,37 @@ fn snap_refuses_bad_input_without_writing() {
         .iter()
         .all(|p| (p.x - 40.0).abs() < 0.5));
 }
+
+#[test]
+fn snap_keeps_a_closed_curve_closed_with_its_closing_span_refined() {
+    let d = common::scratch("snap-closed");
+    write_step(&d.join("a.exr"), 40.0);
+    write_step(&d.join("b.exr"), 40.0);
+    // A thin closed loop hugging the edge at x = 40: up at x = 43, back
+    // down at x = 44 (the closing span runs from the top back to the start).
+    let scene = r#"{"features": [{"name": "loop", "type": "curve", "closed": true,
+        "a": [[43, 10], [43, 32], [43, 54], [44, 32]], "b": [[43, 10], [43, 32], [43, 54], [44, 32]]}]}"#;
+    std::fs::write(d.join("s.json"), scene).unwrap();
+    let out = d.join("snapped.json");
+    let r = common::run_morphfx(&[
+        "snap",
+        "--scene",
+        s(&d.join("s.json")),
+        "--a",
+        s(&d.join("a.exr")),
+        "--b",
+        s(&d.join("b.exr")),
+        "-o",
+        s(&out),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let snapped = Scene::parse(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let f = &snapped.features[0];
+    assert!(f.closed, "still closed");
+    // Four spans of 20 samples, the first point once.
+    assert_eq!(f.a.len(), 80);
+    assert_ne!(f.a[0], f.a[79]);
+    for p in &f.a {
+        assert!((p.x - 40.0).abs() < 0.5, "{p:?}");
+    }
+}
