@@ -203,9 +203,12 @@ impl Document {
         Ok(false)
     }
 
-    /// Deletes feature `feature` from every key.
+    /// Deletes feature `feature` from every key. Transition curves attached
+    /// by index to later features follow them down; one attached to this
+    /// feature refuses the delete (the curve would be lost or misplaced).
     pub fn delete_feature(&mut self, feature: usize) -> Result<()> {
         self.edit(|doc| {
+            renumber_transition_curves(&mut doc.root, feature)?;
             for list in doc.lists()? {
                 if feature >= list.len() {
                     return Err(missing(feature, "it"));
@@ -391,6 +394,35 @@ fn keyframes_json(root: &mut Map<String, Value>) -> Result<&mut Vec<Value>> {
     root.get_mut("keyframes")
         .and_then(Value::as_array_mut)
         .ok_or_else(|| Error::scene("keyframes", "not a list"))
+}
+
+/// Transition curves attached by index (`"feature": k`) to features after
+/// `deleted` move down by one; one attached to `deleted` is an error.
+fn renumber_transition_curves(root: &mut Map<String, Value>, deleted: usize) -> Result<()> {
+    let Some(transition) = root.get_mut("transition").and_then(Value::as_object_mut) else {
+        return Ok(());
+    };
+    for (rate, settings) in transition.iter_mut() {
+        let curves = settings.get_mut("curves").and_then(Value::as_array_mut);
+        for (i, curve) in curves.into_iter().flatten().enumerate() {
+            let Some(k) = curve.get("feature").and_then(Value::as_u64) else {
+                continue;
+            };
+            let k = k as usize;
+            if k == deleted {
+                return Err(Error::scene(
+                    format!("transition.{rate}.curves[{i}]"),
+                    format!(
+                        "is attached to features[{deleted}]: detach it before deleting the feature"
+                    ),
+                ));
+            }
+            if k > deleted {
+                curve["feature"] = Value::from(k - 1);
+            }
+        }
+    }
+    Ok(())
 }
 
 fn as_list<'v>(v: &'v mut Value, at: &str) -> Result<&'v mut Vec<Value>> {

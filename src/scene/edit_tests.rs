@@ -170,3 +170,26 @@ fn many_keys_in_one_edit_key_a_static_scene_at_each_frame() {
         .is_err());
     assert_eq!(d.keyed_frames(), [1001.0, 1002.0, 1003.0]);
 }
+
+#[test]
+fn deleting_a_feature_keeps_transition_curves_on_theirs() {
+    let text = r#"{"features": [
+        {"type": "point", "a": [[1, 1]], "b": [[1, 1]]},
+        {"type": "point", "a": [[5, 5]], "b": [[6, 6]]},
+        {"type": "point", "a": [[9, 9]], "b": [[9, 8]]}],
+      "transition": {"geometry": {"type": "curves", "curves": [
+        {"feature": 2, "keys": [[0.5, 0.2]]}, {"feature": 1, "keys": [[0.5, 0.8]]}]}}}"#;
+    let mut d = Document::parse(text).unwrap();
+    // Feature 1 carries a curve: refused, nothing changes.
+    let err = d.delete_feature(1).unwrap_err().to_string();
+    assert!(err.contains("transition.geometry.curves[1]"), "{err}");
+    assert_eq!(d.scene().features.len(), 3);
+    // Feature 0 goes; the curves now name features 1 and 0, the same points.
+    d.delete_feature(0).unwrap();
+    let v: Value = serde_json::from_str(&d.text()).unwrap();
+    let curves = &v["transition"]["geometry"]["curves"];
+    assert_eq!(
+        (curves[0]["feature"].as_u64(), curves[1]["feature"].as_u64()),
+        (Some(1), Some(0))
+    );
+}
