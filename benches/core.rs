@@ -128,6 +128,51 @@ fn bench_resample(c: &mut Criterion) {
         });
     }
     g.finish();
+    // The same map and plate as 8- and 16-bit RGBA, what Resolve and Natron
+    // send, into float rows as the nodes resample them.
+    let mut g = c.benchmark_group("resample_1080p_rgba_int");
+    g.sample_size(20);
+    let layout = morphfx::image::Layout::packed(frame(), 4);
+    let bytes: Vec<u8> = src
+        .data
+        .iter()
+        .map(|v| (v.clamp(0.0, 1.0) * 255.0) as u8)
+        .collect();
+    let shorts: Vec<u16> = src
+        .data
+        .iter()
+        .map(|v| (v.clamp(0.0, 1.0) * 65535.0) as u16)
+        .collect();
+    let settings = ResampleSettings {
+        filter: Filter::Bilinear,
+        edge: EdgeMode::Clamp,
+        premultiplied: true,
+    };
+    let view8 = morphfx::image::ImageView::new(&bytes, layout).unwrap();
+    let view16 = morphfx::image::ImageView::new(&shorts, layout).unwrap();
+    g.bench_function("bilinear_u8", |b| {
+        b.iter(|| {
+            resample(
+                view8,
+                PixelScale::UNIT,
+                &map,
+                dst.view_mut().rows(),
+                settings,
+            )
+        })
+    });
+    g.bench_function("bilinear_u16", |b| {
+        b.iter(|| {
+            resample(
+                view16,
+                PixelScale::UNIT,
+                &map,
+                dst.view_mut().rows(),
+                settings,
+            )
+        })
+    });
+    g.finish();
 }
 
 fn bench_morph(c: &mut Criterion) {

@@ -1,7 +1,7 @@
 //! The in-between image: both sources warped toward the same feature positions
 //! and dissolved (Beier-Neely §3.4).
 
-use crate::image::bilinear_rgba::blend_row;
+use crate::image::direct_rgba::blend_row;
 use crate::image::resample::{adapt_channels, fill_rows, map_span, row_through};
 use crate::image::WarpMap;
 use crate::image::{Plane, RowsMut, Sample, Sampler};

@@ -5,7 +5,8 @@
 //! A view's rows are addressed bottom-up in canonical pixel indices: pixel
 //! `(i, j)` of `bounds` starts at `base + (j - y1) * row_stride + (i - x1) * channels`.
 
-pub(crate) mod bilinear_rgba;
+pub(crate) mod direct_rgba;
+mod kernel;
 pub mod resample;
 mod sample;
 mod warp_map;

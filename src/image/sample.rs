@@ -3,7 +3,8 @@
 
 use wide::f32x8;
 
-use super::bilinear_rgba::{self, Taps, SNAP};
+use super::direct_rgba::{self, Taps, SNAP};
+use super::kernel::{catmull_rom_weights, catmull_rom_weights8};
 use super::{ImageView, Sample};
 use crate::choice::Choice;
 use crate::geom::{PixelScale, RectI};
@@ -135,15 +136,22 @@ impl<'a, T: Sample> Sampler<'a, T> {
         self.edge
     }
 
-    /// Direct taps for the bilinear kernel of premultiplied float RGBA
-    /// ([`bilinear_rgba`]); `None` for any other kind of source, which
-    /// takes the general path.
+    /// Direct taps for the bilinear or bicubic kernel of premultiplied
+    /// float RGBA ([`direct_rgba`]); `None` for any other kind of source,
+    /// which takes the general path.
     pub(crate) fn direct_taps(&self) -> Option<Taps<'a>> {
-        if self.filter != Filter::Bilinear || self.view.channels() != 4 || self.alpha_weighted {
+        if self.view.channels() != 4 || self.alpha_weighted {
             return None;
         }
         let data = T::as_f32(self.view.data)?;
-        Taps::new(data, self.view.bounds(), self.view.layout, self.scale())
+        let cubic = self.filter == Filter::Bicubic;
+        Taps::new(
+            data,
+            self.view.bounds(),
+            self.view.layout,
+            self.scale(),
+            cubic,
+        )
     }
 
     /// Whether colour is weighted by alpha while filtering (straight RGBA).
@@ -245,12 +253,17 @@ impl<'a, T: Sample> Sampler<'a, T> {
             (4, true, false) => self.row::<4, true, false>(positions, out),
             (4, true, true) => self.row::<4, true, true>(positions, out),
             (4, false, false) => match self.direct_taps() {
-                Some(taps) => bilinear_rgba::row(&taps, positions, out, |n, o| {
+                Some(taps) => direct_rgba::row(&taps, positions, out, |n, o| {
                     self.sample(positions[n][0], positions[n][1], o)
                 }),
                 None => self.row::<4, false, false>(positions, out),
             },
-            (4, false, true) => self.row::<4, false, true>(positions, out),
+            (4, false, true) => match self.direct_taps() {
+                Some(taps) => direct_rgba::row(&taps, positions, out, |n, o| {
+                    self.sample(positions[n][0], positions[n][1], o)
+                }),
+                None => self.row::<4, false, true>(positions, out),
+            },
             (3, _, false) => self.row::<3, false, false>(positions, out),
             (3, _, true) => self.row::<3, false, true>(positions, out),
             (2, _, false) => self.row::<2, false, false>(positions, out),
@@ -459,34 +472,6 @@ fn split(f: f32) -> (i32, f32) {
     } else {
         (i, t)
     }
-}
-
-/// [`catmull_rom_weights`] for eight fractions at once.
-#[inline(always)]
-fn catmull_rom_weights8(t: f32x8) -> [f32x8; 4] {
-    let h = f32x8::splat(0.5);
-    let c = f32x8::splat;
-    let t2 = t * t;
-    let t3 = t2 * t;
-    [
-        h * (-t3 + c(2.0) * t2 - t),
-        h * (c(3.0) * t3 - c(5.0) * t2 + c(2.0)),
-        h * (c(-3.0) * t3 + c(4.0) * t2 + t),
-        h * (t3 - t2),
-    ]
-}
-
-/// Catmull-Rom weights for taps at offsets −1, 0, 1, 2 from the fraction `t`.
-#[inline]
-fn catmull_rom_weights(t: f32) -> [f32; 4] {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    [
-        0.5 * (-t3 + 2.0 * t2 - t),
-        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
-        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
-        0.5 * (t3 - t2),
-    ]
 }
 
 #[cfg(test)]

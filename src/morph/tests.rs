@@ -100,16 +100,6 @@ fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
         row_stride: -(w as isize),
     };
     let b_view = ImageView::new(&top_down, layout).unwrap();
-    let sampler = |view| {
-        Sampler::new(
-            view,
-            PixelScale::UNIT,
-            Filter::Bilinear,
-            EdgeMode::Clamp,
-            true,
-        )
-    };
-    let (sa, sb) = (sampler(a.view()), sampler(b_view));
     let map = |window: RectI, seed| {
         WarpMap::new(
             window,
@@ -118,27 +108,33 @@ fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
         )
     };
     let narrow = RectI::new(0, 2, 30, 31);
-    for (ma, mb) in [
+    let maps = [
         (map(bounds, 1), map(bounds, 2)),
         (map(bounds, 3), map(narrow, 4)),
-    ] {
+    ];
+    for ((ma, mb), filter) in maps
+        .iter()
+        .flat_map(|m| [(m, Filter::Bilinear), (m, Filter::Bicubic)])
+    {
+        let sampler = |view| Sampler::new(view, PixelScale::UNIT, filter, EdgeMode::Clamp, true);
+        let (sa, sb) = (sampler(a.view()), sampler(b_view));
         for t in [0.3, 0.75] {
             let mut got = Image::new(bounds, 4);
             dissolve(
-                Warped::Map(&sa, &ma),
-                Warped::Map(&sb, &mb),
+                Warped::Map(&sa, ma),
+                Warped::Map(&sb, mb),
                 t,
                 got.view_mut().rows(),
             );
             let (mut ra, mut rb) = (Image::new(bounds, 4), Image::new(bounds, 4));
-            through(&sa, &ma, ra.view_mut().rows());
-            through(&sb, &mb, rb.view_mut().rows());
+            through(&sa, ma, ra.view_mut().rows());
+            through(&sb, mb, rb.view_mut().rows());
             let (wa, wb) = ((1.0 - t) as f32, t as f32);
             for (k, g) in got.data.iter().enumerate() {
                 let want = wb.mul_add(rb.data[k], wa * ra.data[k]);
                 assert!(
                     g.to_bits() == want.to_bits(),
-                    "t {t}, sample {k}: {g} vs {want}"
+                    "{filter:?} t {t}, sample {k}: {g} vs {want}"
                 );
             }
         }

@@ -1,15 +1,18 @@
-//! Bilinear float RGBA, premultiplied: the plate a host usually sends, and
-//! nearly the whole cost of a morph frame once its warps are cached.
+//! Bilinear and bicubic float RGBA, premultiplied: the plate a host usually
+//! sends, and nearly the whole cost of a morph frame once its warps are
+//! cached.
 //!
 //! The general sampler row ([`super::Sampler::sample_row`]) finds each pixel's
 //! row through the view and checks slices per tap; here each tap pair is
 //! addressed from the buffer's origin and stride, so a pixel is a few integer
-//! operations and two eight-wide loads. The dissolve samples both sources of a
+//! operations and two eight-wide loads (bilinear), or eight (bicubic: each
+//! row's four taps are two loads, weighted by pairs of columns at once). The dissolve samples both sources of a
 //! pixel in the same iteration ([`blend_row`]): four independent loads close
 //! together keep more of them in flight, and no second row is written and read
-//! back. Values are bit for bit those of the general path for other sample
-//! types and of the separate blend (the same fused multiply-adds in the same
-//! order). Positions it does not take (taps outside the image, on or near a
+//! back. Bilinear values are bit for bit those of the general path for other
+//! sample types and of the separate blend (the same fused multiply-adds in
+//! the same order); bicubic ones sum the same sixteen products in another
+//! order (within a few float ulps). Positions it does not take (taps outside the image, on or near a
 //! pixel centre, NaN) go to the caller's one-pixel fallback.
 
 use wide::{f32x8, i32x8};
@@ -38,9 +41,12 @@ pub(crate) struct Taps<'a> {
     step: i32x8,
     /// Canonical position to pixel index, x and y interleaved as positions are.
     scale: f32x8,
-    /// Both taps inside: `lo ≤ index < hi` per axis, interleaved likewise.
+    /// Every tap inside: `lo ≤ index < hi` per axis, interleaved likewise;
+    /// `lo` is also the first tap's offset from the integer part.
     lo: f32x8,
     hi: f32x8,
+    /// Catmull-Rom's four taps per axis, else bilinear's two.
+    cubic: bool,
 }
 
 /// Four positions (one eight-wide vector of x, y pairs) located in a source.
@@ -63,20 +69,24 @@ impl<'a> Taps<'a> {
         b: RectI,
         layout: Layout,
         scale: PixelScale,
+        cubic: bool,
     ) -> Option<Self> {
         if data.len() > i32::MAX as usize || layout.row_stride.unsigned_abs() > i32::MAX as usize {
             return None;
         }
         let stride = layout.row_stride as i32;
         let pairs = |x: f32, y: f32| f32x8::new([x, y, x, y, x, y, x, y]);
+        // Taps reach `below` pixels under the integer part and `above` over it.
+        let (below, above) = if cubic { (1, 2) } else { (0, 1) };
         Some(Taps {
             data,
             base: layout.base as i32,
             stride,
             step: i32x8::new([4, stride, 4, stride, 4, stride, 4, stride]),
             scale: pairs(scale.x as f32, scale.y as f32),
-            lo: pairs(b.x1 as f32, b.y1 as f32),
-            hi: pairs((b.x2 - 1) as f32, (b.y2 - 1) as f32),
+            lo: pairs((b.x1 + below) as f32, (b.y1 + below) as f32),
+            hi: pairs((b.x2 - above) as f32, (b.y2 - above) as f32),
+            cubic,
         })
     }
 
@@ -93,6 +103,8 @@ impl<'a> Taps<'a> {
             f.simd_ge(self.lo) & f.simd_lt(self.hi) & t.simd_gt(s(SNAP)) & t.simd_lt(s(1.0 - SNAP));
         Located {
             fast: fast.to_bitmask(),
+            // Relative to the corner: the first tap, one below the integer
+            // part for bicubic (whose `lo` is one above the corner).
             offsets: ((whole - self.lo).fast_trunc_int() * self.step).to_array(),
             t: t.to_array(),
         }
@@ -101,6 +113,9 @@ impl<'a> Taps<'a> {
     /// Pixel `k` of a located four, both axes on the fast path.
     #[inline(always)]
     fn pixel(&self, l: &Located, k: usize) -> [f32; 4] {
+        if self.cubic {
+            return self.cubic_pixel(l, k);
+        }
         let (x, y) = (2 * k, 2 * k + 1);
         // Indices inside the buffer, which fits `i32`; through `u32` the
         // slice end cannot overflow, so one check per load remains.
@@ -117,6 +132,34 @@ impl<'a> Taps<'a> {
             .to_array();
         let tx = l.t[x];
         std::array::from_fn(|c| (v[4 + c] - v[c]).mul_add(tx, v[c]))
+    }
+}
+
+impl Taps<'_> {
+    /// Pixel `k` of a located four by Catmull-Rom: each of the four rows'
+    /// four taps (sixteen floats) is two eight-wide loads, weighted two
+    /// columns at a time, and the rows summed by their weights; the two
+    /// halves of the sum then add up to the pixel.
+    #[inline(always)]
+    fn cubic_pixel(&self, l: &Located, k: usize) -> [f32; 4] {
+        let (x, y) = (2 * k, 2 * k + 1);
+        let at = self.base + l.offsets[x] + l.offsets[y];
+        let load = |at: i32| {
+            let at = at as u32 as usize;
+            f32x8::new(*self.data[at..at + 8].first_chunk().unwrap())
+        };
+        let wx = super::kernel::catmull_rom_weights(l.t[x]);
+        let wy = super::kernel::catmull_rom_weights(l.t[y]);
+        let pair = |a: f32, b: f32| f32x8::new([a, a, a, a, b, b, b, b]);
+        let (left, right) = (pair(wx[0], wx[1]), pair(wx[2], wx[3]));
+        let mut sum = f32x8::ZERO;
+        for (r, w) in wy.iter().enumerate() {
+            let row = at + r as i32 * self.stride;
+            let h = load(row + 8).mul_add(right, load(row) * left);
+            sum = h.mul_add(f32x8::splat(*w), sum);
+        }
+        let v = sum.to_array();
+        std::array::from_fn(|c| v[c] + v[4 + c])
     }
 }
 
