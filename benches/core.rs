@@ -92,9 +92,33 @@ fn bench_field(c: &mut Criterion) {
     g.finish();
 }
 
+/// With `MORPHFX_MAP_DUMP=DIR`, writes `DIR/map_a.f32` and `DIR/map_b.f32`
+/// (the reverse maps of the resample and morph benches, as pixel indices
+/// x, y per output pixel, bottom row first, little-endian f32) for a peer
+/// such as `benches/remap_peer.py` to time the same maps.
+fn dump_map(name: &str, map: &WarpMap) {
+    let Some(dir) = std::env::var_os("MORPHFX_MAP_DUMP") else {
+        return;
+    };
+    let mut bytes = Vec::with_capacity(map.window.area() * 8);
+    for j in map.window.y1..map.window.y2 {
+        for p in map.row(j).unwrap_or_default() {
+            for v in [
+                p[0] * map.scale.x as f32 - 0.5,
+                p[1] * map.scale.y as f32 - 0.5,
+            ] {
+                bytes.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    let path = std::path::Path::new(&dir).join(format!("{name}.f32"));
+    std::fs::write(&path, bytes).expect("the map dump is written");
+}
+
 fn bench_resample(c: &mut Criterion) {
     let src = plate(0.0);
     let map: WarpMap = field(100, Evaluation::default()).map_window(frame(), PixelScale::UNIT);
+    dump_map("map_a", &map);
     let mut dst = Image::new(frame(), 4);
     let mut g = c.benchmark_group("resample_1080p_rgba_f32");
     g.sample_size(20);
@@ -194,6 +218,7 @@ fn bench_morph(c: &mut Criterion) {
     );
     let map_a = warp_a.map_window(frame(), PixelScale::UNIT);
     let map_b = warp_b.map_window(frame(), PixelScale::UNIT);
+    dump_map("map_b", &map_b);
     let mut dst = Image::new(frame(), 4);
     let mut g = c.benchmark_group("morph_frame_1080p_rgba_f32");
     g.sample_size(20);

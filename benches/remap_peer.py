@@ -1,0 +1,62 @@
+"""The peer of the core's resample and morph benches: OpenCV's remap on the
+same reverse maps (written by `MORPHFX_MAP_DUMP=DIR cargo bench ... --bench
+core -- resample_1080p_rgba_f32/bilinear morph_frame`), 1080p RGBA float32,
+clamped edges, as a host's plate would be resampled.
+
+    python benches/remap_peer.py DIR
+
+Prints the median of each over 30 runs, in milliseconds. Measuring only:
+the project does not depend on OpenCV (pip install opencv-python-headless
+numpy in a scratch environment).
+"""
+
+import sys
+import time
+
+import cv2
+import numpy as np
+
+W, H = 1920, 1080
+
+
+def load(path):
+    m = np.fromfile(path, dtype="<f4").reshape(H, W, 2)
+    return np.ascontiguousarray(m[..., 0]), np.ascontiguousarray(m[..., 1])
+
+
+def plate(seed):
+    y, x = np.mgrid[0:H, 0:W].astype(np.float32)
+    img = np.empty((H, W, 4), np.float32)
+    for c in range(3):
+        img[..., c] = 0.5 + 0.5 * np.sin((x * 0.05 + seed) * (c + 1)) * np.cos(y * 0.031)
+    img[..., 3] = 1.0
+    return img
+
+
+def median_ms(f, runs=30):
+    f()
+    times = []
+    for _ in range(runs):
+        t = time.perf_counter()
+        f()
+        times.append(time.perf_counter() - t)
+    return 1000 * sorted(times)[len(times) // 2]
+
+
+def main(directory):
+    ax, ay = load(f"{directory}/map_a.f32")
+    bx, by = load(f"{directory}/map_b.f32")
+    a, b = plate(0.0), plate(1.7)
+    border = cv2.BORDER_REPLICATE
+    for name, interp in [("bilinear", cv2.INTER_LINEAR), ("bicubic", cv2.INTER_CUBIC)]:
+        ms = median_ms(lambda: cv2.remap(a, ax, ay, interp, borderMode=border))
+        print(f"remap {name}: {ms:.2f} ms")
+        morph = lambda: cv2.addWeighted(
+            cv2.remap(a, ax, ay, interp, borderMode=border), 0.63,
+            cv2.remap(b, bx, by, interp, borderMode=border), 0.37, 0.0)
+        print(f"2 x remap + addWeighted {name}: {median_ms(morph):.2f} ms")
+    print(f"threads: {cv2.getNumThreads()}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
