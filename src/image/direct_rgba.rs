@@ -17,7 +17,7 @@
 
 use wide::{f32x8, i32x8};
 
-use super::Layout;
+use super::{Layout, Sample};
 use crate::geom::{PixelScale, RectI};
 
 /// Fractions this close to a pixel centre snap to it, so warps that land on
@@ -26,10 +26,10 @@ use crate::geom::{PixelScale, RectI};
 /// leaves to it are those it would snap.
 pub(crate) const SNAP: f32 = 1e-4;
 
-/// A source sampled by direct addressing; see [`Taps::of`].
+/// A source sampled by direct addressing; see [`Taps::new`].
 #[derive(Clone, Copy)]
-pub(crate) struct Taps<'a> {
-    data: &'a [f32],
+pub(crate) struct Taps<'a, T> {
+    data: &'a [T],
     /// Index of the first sample of the bounds' corner pixel.
     base: i32,
     /// Samples from one row to the next row up.
@@ -59,13 +59,13 @@ struct Located {
     t: [f32; 8],
 }
 
-impl<'a> Taps<'a> {
+impl<'a, T: Sample> Taps<'a, T> {
     /// Direct taps into premultiplied RGBA floats `data` laid out as
     /// `layout`, covering pixels `b` at `scale` (see
     /// [`super::Sampler::direct_taps`]); `None` for a buffer too large to
     /// address in `i32`.
     pub(crate) fn new(
-        data: &'a [f32],
+        data: &'a [T],
         b: RectI,
         layout: Layout,
         scale: PixelScale,
@@ -122,7 +122,7 @@ impl<'a> Taps<'a> {
         let at = self.base + l.offsets[x] + l.offsets[y];
         let load = |at: i32| {
             let at = at as u32 as usize;
-            f32x8::new(*self.data[at..at + 8].first_chunk().unwrap())
+            T::load8(&self.data[at..at + 8])
         };
         let (below, above) = (load(at), load(at + self.stride));
         // Each row's pair of horizontal neighbours blended vertically, then
@@ -135,7 +135,7 @@ impl<'a> Taps<'a> {
     }
 }
 
-impl Taps<'_> {
+impl<T: Sample> Taps<'_, T> {
     /// Pixel `k` of a located four by Catmull-Rom: each of the four rows'
     /// four taps (sixteen floats) is two eight-wide loads, weighted two
     /// columns at a time, and the rows summed by their weights; the two
@@ -146,7 +146,7 @@ impl Taps<'_> {
         let at = self.base + l.offsets[x] + l.offsets[y];
         let load = |at: i32| {
             let at = at as u32 as usize;
-            f32x8::new(*self.data[at..at + 8].first_chunk().unwrap())
+            T::load8(&self.data[at..at + 8])
         };
         let wx = super::kernel::catmull_rom_weights(l.t[x]);
         let wy = super::kernel::catmull_rom_weights(l.t[y]);
@@ -170,8 +170,8 @@ fn groups(positions: &[[f32; 2]]) -> &[[f32; 8]] {
 
 /// Samples `taps` at each of `positions` into `out`; `slow(n, out)` computes
 /// pixel `n` wherever the direct path does not apply.
-pub(crate) fn row(
-    taps: &Taps<'_>,
+pub(crate) fn row<T: Sample>(
+    taps: &Taps<'_, T>,
     positions: &[[f32; 2]],
     out: &mut [[f32; 4]],
     slow: impl Fn(usize, &mut [f32; 4]),
@@ -196,9 +196,9 @@ pub(crate) fn row(
 /// `out = wa · A + wb · B`, A sampled at `pa` and B at `pb`, both sources of
 /// a pixel in one iteration; each source's `slow(n)` gives its pixel `n`
 /// wherever the direct path does not apply to it.
-pub(crate) fn blend_row(
-    (a, pa, wa, slow_a): (&Taps<'_>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
-    (b, pb, wb, slow_b): (&Taps<'_>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
+pub(crate) fn blend_row<S: Sample>(
+    (a, pa, wa, slow_a): (&Taps<'_, S>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
+    (b, pb, wb, slow_b): (&Taps<'_, S>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
     out: &mut [[f32; 4]],
 ) {
     assert!(

@@ -137,21 +137,15 @@ impl<'a, T: Sample> Sampler<'a, T> {
     }
 
     /// Direct taps for the bilinear or bicubic kernel of premultiplied
-    /// float RGBA ([`direct_rgba`]); `None` for any other kind of source,
-    /// which takes the general path.
-    pub(crate) fn direct_taps(&self) -> Option<Taps<'a>> {
+    /// RGBA of any sample type ([`direct_rgba`]); `None` for any other
+    /// layout, which takes the general path.
+    pub(crate) fn direct_taps(&self) -> Option<Taps<'a, T>> {
         if self.view.channels() != 4 || self.alpha_weighted {
             return None;
         }
-        let data = T::as_f32(self.view.data)?;
         let cubic = self.filter == Filter::Bicubic;
-        Taps::new(
-            data,
-            self.view.bounds(),
-            self.view.layout,
-            self.scale(),
-            cubic,
-        )
+        let (data, layout) = (self.view.data, self.view.layout);
+        Taps::new(data, self.view.bounds(), layout, self.scale(), cubic)
     }
 
     /// Whether colour is weighted by alpha while filtering (straight RGBA).
