@@ -212,7 +212,8 @@ pub enum Command {
         kind: JobKind,
     },
     /// Time a whole sequence morph on generated plates (EXR IO included) and
-    /// say where the time went.
+    /// say where the time went; with --drag, the re-render after one of 100
+    /// lines moves, as while a compositor drags it.
     Bench {
         #[arg(short = 'o', long = "output", default_value = "morphfx-bench")]
         output: PathBuf,
@@ -222,6 +223,12 @@ pub enum Command {
         width: usize,
         #[arg(long, default_value_t = 1080)]
         height: usize,
+        /// Time renders after a line moves (in this process, no files).
+        #[arg(long)]
+        drag: bool,
+        /// Renders timed per render scale with --drag.
+        #[arg(long, default_value_t = 20)]
+        moves: usize,
     },
 }
 

@@ -6,7 +6,7 @@ use clap::Parser;
 use morphfx::snake::SnakeSettings;
 use morphfx_harness::cli::{Cli, Command, JobKind};
 use morphfx_harness::commands::{
-    bench, demo, find_bundle, job, openjd, overlay, params, plugins, track,
+    bench, demo, drag, find_bundle, job, openjd, overlay, params, plugins, track,
 };
 use morphfx_harness::host::{ErrorKind, HostError};
 use morphfx_harness::interrupt;
@@ -125,10 +125,18 @@ fn run(cli: Cli) -> Result<(), HostError> {
             command: &command,
         }),
         Command::Bench {
+            drag: true,
+            width,
+            height,
+            moves,
+            ..
+        } => drag::drag(&bundle_path()?, (width, height), moves),
+        Command::Bench {
             output,
             frames,
             width,
             height,
+            ..
         } => bench::bench(&bundle_path()?, &output, frames, (width, height)),
     }
 }

@@ -533,3 +533,26 @@ fn a_plate_over_the_size_limit_is_refused_from_its_header() {
     );
     assert!(!out.exists());
 }
+
+/// `morphfx bench --drag` runs as a user runs it, says what it timed, and
+/// refuses a frame it cannot bench.
+#[test]
+fn bench_drag_times_renders_after_a_move_at_both_scales() {
+    let run = common::run_morphfx(&[
+        "bench", "--drag", "--width", "64", "--height", "48", "--moves", "2",
+    ]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{err}");
+    for scale in ["render scale 1:", "render scale 0.5:"] {
+        let line = err
+            .lines()
+            .find(|l| l.contains(scale))
+            .unwrap_or_else(|| panic!("{scale} in {err}"));
+        assert!(
+            line.contains("ms after a move") && line.contains("with nothing moved"),
+            "{line}"
+        );
+    }
+    let bad = common::run_morphfx(&["bench", "--drag", "--moves", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod demo;
+pub mod drag;
 pub mod job;
 pub mod line_key;
 pub mod openjd;

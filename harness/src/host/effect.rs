@@ -48,8 +48,15 @@ pub struct Clip {
     pub source: Mutex<Option<Arc<dyn FrameSource>>>,
     /// The buffer renders write into (output clip).
     pub output: Mutex<Option<Arc<Frame>>>,
+    /// The last proxy made: the source frame it came from, its render
+    /// scale, and the proxy. A host keeps proxies rather than filtering
+    /// the plate again for every render at the same scale.
+    proxy: Mutex<Option<Proxy>>,
     effect: *const Effect,
 }
+
+/// A proxy: the frame it was made from, its render scale, the proxy.
+type Proxy = (Arc<Frame>, (f64, f64), Arc<Frame>);
 
 // SAFETY: `effect` points at the owning Effect, which outlives its clips and is
 // itself shared between threads only through its own locks.
@@ -143,6 +150,7 @@ impl Effect {
             props,
             source: Mutex::new(None),
             output: Mutex::new(None),
+            proxy: Mutex::new(None),
             effect: self,
         });
         clip.props.set_str(kOfxPropName, name);
@@ -336,11 +344,18 @@ impl Clip {
             .render_scale
             .lock()
             .unwrap_or_else(|e| e.into_inner());
-        Ok(Some(if scale == (1.0, 1.0) {
-            frame
-        } else {
-            Arc::new(frame.scaled(scale))
-        }))
+        if scale == (1.0, 1.0) {
+            return Ok(Some(frame));
+        }
+        let mut proxy = self.proxy.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((from, at, made)) = proxy.as_ref() {
+            if Arc::ptr_eq(from, &frame) && *at == scale {
+                return Ok(Some(made.clone()));
+            }
+        }
+        let made = Arc::new(frame.scaled(scale));
+        *proxy = Some((frame, scale, made.clone()));
+        Ok(Some(made))
     }
 
     /// Canonical region of definition at `time` (the full-resolution bounds).
