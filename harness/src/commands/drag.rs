@@ -70,7 +70,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Drags line 0 of [`LINES`] by a pixel per render, `moves` times, at each
+/// Drags line 0 of the scene's lines by a pixel per render, `moves` times, at each
 /// render scale, and prints the median render beside the unchanged one.
 pub fn drag(
     bundle_path: &std::path::Path,
