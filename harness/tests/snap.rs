@@ -19,6 +19,24 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `morphfx snap` of `d/s.json` on `d/a.exr` and `d/b.exr` into `out`,
+/// which must succeed; the scene it wrote.
+fn snap_in(d: &Path, out: &Path) -> Scene {
+    let r = common::run_morphfx(&[
+        "snap",
+        "--scene",
+        s(&d.join("s.json")),
+        "--a",
+        s(&d.join("a.exr")),
+        "--b",
+        s(&d.join("b.exr")),
+        "-o",
+        s(out),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    Scene::parse(&std::fs::read_to_string(out).unwrap()).unwrap()
+}
+
 const SCENE: &str = r#"{"format": "morphfx-scene", "version": 1, "method": "field",
   "field": {"b": 1.5},
   "features": [
@@ -32,21 +50,7 @@ fn snap_moves_curves_onto_the_edges_of_each_plate_and_keeps_the_rest() {
     write_step(&d.join("a.exr"), 40.0);
     write_step(&d.join("b.exr"), 52.0);
     std::fs::write(d.join("s.json"), SCENE).unwrap();
-    let out = d.join("snapped.json");
-    let r = common::run_morphfx(&[
-        "snap",
-        "--scene",
-        s(&d.join("s.json")),
-        "--a",
-        s(&d.join("a.exr")),
-        "--b",
-        s(&d.join("b.exr")),
-        "-o",
-        s(&out),
-    ]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let text = std::fs::read_to_string(&out).unwrap();
-    let scene = Scene::parse(&text).unwrap();
+    let scene = snap_in(&d, &d.join("snapped.json"));
     let edge = &scene.features[0];
     assert_eq!(edge.name.as_deref(), Some("edge"));
     assert_eq!(edge.kind.name(), "polyline");
@@ -134,20 +138,7 @@ fn snap_keeps_a_closed_curve_closed_with_its_closing_span_refined() {
     let scene = r#"{"features": [{"name": "loop", "type": "curve", "closed": true,
         "a": [[43, 10], [43, 32], [43, 54], [44, 32]], "b": [[43, 10], [43, 32], [43, 54], [44, 32]]}]}"#;
     std::fs::write(d.join("s.json"), scene).unwrap();
-    let out = d.join("snapped.json");
-    let r = common::run_morphfx(&[
-        "snap",
-        "--scene",
-        s(&d.join("s.json")),
-        "--a",
-        s(&d.join("a.exr")),
-        "--b",
-        s(&d.join("b.exr")),
-        "-o",
-        s(&out),
-    ]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let snapped = Scene::parse(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let snapped = snap_in(&d, &d.join("snapped.json"));
     let f = &snapped.features[0];
     assert!(f.closed, "still closed");
     // Four spans of 20 samples, the first point once.
