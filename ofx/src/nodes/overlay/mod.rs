@@ -13,7 +13,7 @@ pub mod shapes;
 
 use std::sync::Mutex;
 
-use morphfx::features::{Feature, Side};
+use morphfx::features::Side;
 use morphfx::geom::Vec2;
 use morphfx::scene::edit::Document;
 
@@ -327,9 +327,4 @@ pub fn delete_shape(instance: &NodeState, effect: &EffectHandle, time: f64) -> O
             .edit_block("Delete Shape", || shapes::write(instance, &doc))
     });
     shapes::settle(instance, effect, result)
-}
-
-/// A new point feature at `at` on both sides.
-fn point_feature(at: Vec2) -> Feature {
-    Feature::point(at, at)
 }

@@ -4,13 +4,13 @@
 //! (an edit block from pen down to pen up), and a drag writes its param
 //! (a slot's end, or Scene Text) once per pen event.
 
-use morphfx::features::{FeatureKind, Side};
+use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::Vec2;
 
 use super::hit::{self, Handle, Part};
 use super::outline::Owner;
 use super::shapes::{self, refused};
-use super::{editable, lock, pixel_of, point_feature, view, Building, Drag, MIN_NEW_LINE_PX};
+use super::{editable, lock, pixel_of, view, Building, Drag, MIN_NEW_LINE_PX};
 use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
 use crate::nodes::params::{OVERLAY_EDIT, OVERLAY_SHOW};
@@ -172,7 +172,9 @@ fn grab_shape(
 /// The point tool: a point feature at the pen, dragged until pen up.
 fn new_point(instance: &NodeState, pen: Pen) -> Outcome<Drag> {
     let mut doc = shapes::document(instance, pen.time)?;
-    let feature = doc.add_feature(&point_feature(pen.at)).map_err(refused)?;
+    let feature = doc
+        .add_feature(&Feature::point(pen.at, pen.at))
+        .map_err(refused)?;
     instance.params().begin_edit("New Point")?;
     Ok(Drag::Shape {
         feature,
@@ -366,11 +368,7 @@ fn building_click(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outc
                 i
             }
             None => {
-                let f = morphfx::features::Feature::new(
-                    b.kind,
-                    vec![first, pen.at],
-                    vec![first, pen.at],
-                );
+                let f = Feature::new(b.kind, vec![first, pen.at], vec![first, pen.at]);
                 doc.add_feature(&f).map_err(refused)?
             }
         };
