@@ -19,20 +19,32 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `morphfx snap --scene SCENE --a A --b B -o OUT EXTRA...`.
+fn run_snap(scene: &Path, a: &Path, b: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let args = [
+        "snap",
+        "--scene",
+        s(scene),
+        "--a",
+        s(a),
+        "--b",
+        s(b),
+        "-o",
+        s(out),
+    ];
+    common::run_morphfx(&[&args[..], extra].concat())
+}
+
 /// `morphfx snap` of `d/s.json` on `d/a.exr` and `d/b.exr` into `out`,
 /// which must succeed; the scene it wrote.
 fn snap_in(d: &Path, out: &Path) -> Scene {
-    let r = common::run_morphfx(&[
-        "snap",
-        "--scene",
-        s(&d.join("s.json")),
-        "--a",
-        s(&d.join("a.exr")),
-        "--b",
-        s(&d.join("b.exr")),
-        "-o",
-        s(out),
-    ]);
+    let r = run_snap(
+        &d.join("s.json"),
+        &d.join("a.exr"),
+        &d.join("b.exr"),
+        out,
+        &[],
+    );
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     Scene::parse(&std::fs::read_to_string(out).unwrap()).unwrap()
 }
@@ -75,51 +87,37 @@ fn snap_refuses_bad_input_without_writing() {
     std::fs::write(d.join("s.json"), SCENE).unwrap();
     let out = d.join("snapped.json");
     // A missing plate.
-    let r = common::run_morphfx(&[
-        "snap",
-        "--scene",
-        s(&d.join("s.json")),
-        "--a",
-        s(&d.join("a.exr")),
-        "--b",
-        s(&d.join("missing.exr")),
-        "-o",
-        s(&out),
-    ]);
+    let r = run_snap(
+        &d.join("s.json"),
+        &d.join("a.exr"),
+        &d.join("missing.exr"),
+        &out,
+        &[],
+    );
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("missing.exr"));
     assert!(!out.exists());
     // A keyframed scene without --frame.
     let keyed = r#"{"keyframes": [{"frame": 5, "features": [{"type": "polyline", "a": [[44, 10], [44, 54]], "b": [[48, 10], [48, 54]]}]}]}"#;
     std::fs::write(d.join("k.json"), keyed).unwrap();
-    let r = common::run_morphfx(&[
-        "snap",
-        "--scene",
-        s(&d.join("k.json")),
-        "--a",
-        s(&d.join("a.exr")),
-        "--b",
-        s(&d.join("a.exr")),
-        "-o",
-        s(&out),
-    ]);
+    let r = run_snap(
+        &d.join("k.json"),
+        &d.join("a.exr"),
+        &d.join("a.exr"),
+        &out,
+        &[],
+    );
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("--frame"));
     assert!(!out.exists());
     // With --frame 5 it refines that keyframe.
-    let r = common::run_morphfx(&[
-        "snap",
-        "--scene",
-        s(&d.join("k.json")),
-        "--a",
-        s(&d.join("a.exr")),
-        "--b",
-        s(&d.join("a.exr")),
-        "--frame",
-        "5",
-        "-o",
-        s(&out),
-    ]);
+    let r = run_snap(
+        &d.join("k.json"),
+        &d.join("a.exr"),
+        &d.join("a.exr"),
+        &out,
+        &["--frame", "5"],
+    );
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let scene = Scene::parse(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert!(scene.keyframes[0].features[0]
