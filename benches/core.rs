@@ -89,6 +89,16 @@ fn bench_field(c: &mut Criterion) {
             b.iter(|| black_box(adaptive.map_window(frame(), PixelScale::UNIT)))
         });
     }
+    // A line being dragged: the map redone from the one before the move.
+    let before = field(100, Evaluation::default());
+    let kept = before.field_map(frame(), PixelScale::UNIT);
+    let mut pairs = before.pairs().to_vec();
+    pairs[0].dst.0 += Vec2::new(0.5, 0.0);
+    pairs[0].src.0 += Vec2::new(1.0, 0.0);
+    let moved = FieldWarp::new(pairs, &FieldSettings::default());
+    g.bench_function("adaptive_100_lines_one_moved", |b| {
+        b.iter(|| black_box(moved.field_map_after(frame(), PixelScale::UNIT, Some(&kept))))
+    });
     g.finish();
 }
 

@@ -90,6 +90,24 @@ pub fn toward(
     })
 }
 
+/// The `field` warp as [`toward`] makes it, as its own type: a host redoes
+/// its map cheaply after a line moves ([`FieldWarp::field_map_after`]).
+pub fn field_toward(
+    features: &[Feature],
+    side: Side,
+    t: f64,
+    settings: &WarpSettings,
+) -> Result<FieldWarp> {
+    with_tween(features, t, settings, |tween| {
+        Ok(FieldWarp::toward(
+            features,
+            side,
+            tween,
+            &settings.settings.field,
+        ))
+    })
+}
+
 /// The `thin-plate` warp as [`toward`] makes it, its plates solved from
 /// `warm` (the same side's plates at a sequence's previous frame; a plate on
 /// another grid is ignored): a host rendering frame after frame keeps each

@@ -110,18 +110,19 @@ impl Lines {
     /// Positions `(x, y) + Σ w·(X′ − X) / Σ w` over these lines.
     pub fn map_points(&self, xs: &[f32], ys: &[f32], out_x: &mut [f32], out_y: &mut [f32]) {
         let zero = Sums::default();
-        self.map_points_plus(xs, ys, |_| zero, out_x, out_y);
+        self.map_points_plus(xs, ys, |_| zero, (out_x, out_y), None);
     }
 
     /// Like [`Lines::map_points`], with `base(k)` (sums of other lines,
-    /// eight points from `k` on) added before dividing.
+    /// eight points from `k` on) added before dividing; `out_w`, when
+    /// given, gets each point's `Σ w`.
     pub fn map_points_plus(
         &self,
         xs: &[f32],
         ys: &[f32],
         base: impl Fn(usize) -> Sums,
-        out_x: &mut [f32],
-        out_y: &mut [f32],
+        (out_x, out_y): (&mut [f32], &mut [f32]),
+        mut out_w: Option<&mut [f32]>,
     ) {
         self.each8(xs, ys, base, |k, take, x, y, s| {
             // Far from every line a steep falloff can underflow all weights: hold still there.
@@ -129,6 +130,9 @@ impl Lines {
             let inv = ok.select(f32x8::ONE / s.w, f32x8::ZERO);
             out_x[k..k + take].copy_from_slice(&(x + s.x * inv).to_array()[..take]);
             out_y[k..k + take].copy_from_slice(&(y + s.y * inv).to_array()[..take]);
+            if let Some(w) = out_w.as_deref_mut() {
+                w[k..k + take].copy_from_slice(&s.w.to_array()[..take]);
+            }
         });
     }
 
@@ -147,6 +151,46 @@ impl Lines {
                 }
             },
         );
+    }
+
+    /// The sums per point into one slice per component, each padded to
+    /// whole lanes (at least `xs.len()` rounded up to 8 long).
+    pub fn sums_into(&self, xs: &[f32], ys: &[f32], [sx, sy, sw]: [&mut [f32]; 3]) {
+        let zero = Sums::default();
+        self.each8(
+            xs,
+            ys,
+            |_| zero,
+            |k, _, _, _, s| {
+                sx[k..k + 8].copy_from_slice(&s.x.to_array());
+                sy[k..k + 8].copy_from_slice(&s.y.to_array());
+                sw[k..k + 8].copy_from_slice(&s.w.to_array());
+            },
+        );
+    }
+
+    /// These lines' sums per point less `before` (sums laid out as
+    /// [`Lines::sums_into`] writes them), into `out` likewise.
+    pub fn sums_less(
+        &self,
+        xs: &[f32],
+        ys: &[f32],
+        before: [&[f32]; 3],
+        [sx, sy, sw]: [&mut [f32]; 3],
+    ) {
+        let less = |k: usize| {
+            let lane = |m: usize| -f32x8::new(before[m][k..k + 8].try_into().expect("8 lanes"));
+            Sums {
+                x: lane(0),
+                y: lane(1),
+                w: lane(2),
+            }
+        };
+        self.each8(xs, ys, less, |k, _, _, _, s| {
+            sx[k..k + 8].copy_from_slice(&s.x.to_array());
+            sy[k..k + 8].copy_from_slice(&s.y.to_array());
+            sw[k..k + 8].copy_from_slice(&s.w.to_array());
+        });
     }
 
     /// Runs the kernel over points eight at a time: `sink(k, take, x, y, sums)`.

@@ -3,10 +3,12 @@
 
 mod kernel;
 mod lines;
+mod redo;
 pub mod split;
 pub mod weight;
 
 pub use lines::{interpolate_line, line_pairs_toward, LinePair};
+pub use redo::FieldMap;
 
 use crate::choice::Choice;
 use crate::features::{Feature, Side, Tween};
@@ -42,8 +44,6 @@ pub enum Evaluation {
     Exact,
     /// A coarse grid refined where bilinear interpolation would err by more
     /// than `tolerance` pixels ([`split`]).
-    /// A coarse grid refined until bilinear interpolation errs by less than `tolerance`
-    /// pixels.
     Adaptive {
         /// Largest interpolation error allowed (output px).
         tolerance: f64,
@@ -215,5 +215,7 @@ fn exact_map_window(warp: &FieldWarp, window: RectI, scale: PixelScale) -> WarpM
     Exact(warp).map_window(window, scale)
 }
 
+#[cfg(test)]
+mod redo_tests;
 #[cfg(test)]
 mod tests;

@@ -18,7 +18,7 @@ use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
 
 /// Side of a block, pixels.
-const BLOCK: i32 = 48;
+pub(super) const BLOCK: i32 = 48;
 /// Spacing of the far-field grid, pixels.
 const GRID: i32 = 4;
 /// Pixel offsets within a grid cell, as fractions of it.
@@ -26,7 +26,7 @@ const FRACTIONS: [f32; GRID as usize] = [0.0, 0.25, 0.5, 0.75];
 /// Lines closer than this to a block (pixels) are evaluated exactly there.
 /// At this distance a far line's relative curvature over a grid cell is
 /// about `0.75·(GRID/NEAR)² ≈ 7e-4`.
-const NEAR: f64 = 128.0;
+pub(super) const NEAR: f64 = 128.0;
 /// Share of the tolerance the check points must meet, so the unchecked
 /// pixels (whose error is smaller than at cell centres) stay within it.
 const SAFETY: f64 = 0.5;
@@ -37,52 +37,158 @@ pub(super) fn map_window(
     scale: PixelScale,
     tolerance: f64,
 ) -> WarpMap {
-    let (w, h) = (window.width(), window.height());
-    let mut pos = vec![[0f32; 2]; w * h];
-    if w == 0 || h == 0 {
-        return WarpMap::new(window, scale, pos);
-    }
-    // Destination segments in this window's pixel space (centres at k + 0.5).
-    let segments: Vec<(Vec2, Vec2)> = warp
-        .pairs
-        .iter()
-        .map(|l| (scale.to_pixel(l.dst.0), scale.to_pixel(l.dst.1)))
-        .collect();
-    let tol = [
-        (tolerance * SAFETY / scale.x.max(1e-9)) as f32,
-        (tolerance * SAFETY / scale.y.max(1e-9)) as f32,
-    ];
-    pos.par_chunks_mut(BLOCK as usize * w)
-        .enumerate()
-        .for_each(|(band, out)| {
-            let y1 = window.y1 + band as i32 * BLOCK;
-            let y2 = (y1 + BLOCK).min(window.y2);
-            let mut scratch = Scratch::default();
-            let mut x1 = window.x1;
-            while x1 < window.x2 {
-                let block = RectI::new(x1, y1, (x1 + BLOCK).min(window.x2), y2);
-                let mut b = Block {
-                    warp,
-                    window,
-                    scale,
-                    block,
-                    out: &mut *out,
-                    scratch: &mut scratch,
-                };
-                b.fill(&segments, tol);
-                x1 += BLOCK;
-            }
-        });
+    let mut pos = vec![[0f32; 2]; window.area()];
+    let setup = Setup::new(warp, window, scale, Some(tolerance));
+    let mut made = vec![false; setup.block_count()];
+    setup.each_band(&mut pos, None, &mut made, |band, _, made| {
+        fill_band(band, made)
+    });
     WarpMap::new(window, scale, pos)
 }
 
-struct Block<'a> {
-    warp: &'a FieldWarp,
-    window: RectI,
-    scale: PixelScale,
-    block: RectI,
+/// What every block of one evaluation shares.
+pub(super) struct Setup<'a> {
+    pub warp: &'a FieldWarp,
+    pub window: RectI,
+    pub scale: PixelScale,
+    /// Destination segments in this window's pixel space (centres at k + 0.5).
+    pub segments: Vec<(Vec2, Vec2)>,
+    /// What the check points must meet per axis (pixels); `None` evaluates
+    /// every block exactly.
+    tol: Option<[f32; 2]>,
+}
+
+impl<'a> Setup<'a> {
+    /// `warp` over `window`: adaptive within `tolerance`, or exact without one.
+    pub fn new(
+        warp: &'a FieldWarp,
+        window: RectI,
+        scale: PixelScale,
+        tolerance: Option<f64>,
+    ) -> Self {
+        let segments = warp
+            .pairs
+            .iter()
+            .map(|l| (scale.to_pixel(l.dst.0), scale.to_pixel(l.dst.1)))
+            .collect();
+        let tol = tolerance.map(|t| {
+            [
+                (t * SAFETY / scale.x.max(1e-9)) as f32,
+                (t * SAFETY / scale.y.max(1e-9)) as f32,
+            ]
+        });
+        Setup {
+            warp,
+            window,
+            scale,
+            segments,
+            tol,
+        }
+    }
+
+    fn blocks_across(&self) -> usize {
+        self.window.width().div_ceil(BLOCK as usize)
+    }
+
+    /// Blocks in the window, numbered row of blocks by row from the bottom.
+    pub fn block_count(&self) -> usize {
+        self.blocks_across() * self.window.height().div_ceil(BLOCK as usize)
+    }
+
+    /// Runs `f(band, first, made)` on every row of blocks (a band), in
+    /// parallel, into `pos` and, when kept, `weights` (`Σ w` per pixel):
+    /// `first` numbers the band's first block, and `made` has one entry
+    /// per block of the band, for whether its far field was interpolated.
+    pub fn each_band(
+        &self,
+        pos: &mut [[f32; 2]],
+        weights: Option<&mut [f32]>,
+        made: &mut [bool],
+        f: impl Fn(&mut Band, usize, &mut [bool]) + Sync,
+    ) {
+        let (w, across) = (self.window.width(), self.blocks_across());
+        if w == 0 || self.window.height() == 0 {
+            return;
+        }
+        let rows = BLOCK as usize * w;
+        let weight_bands: Vec<Option<&mut [f32]>> = match weights {
+            Some(ws) => ws.chunks_mut(rows).map(Some).collect(),
+            None => (0..pos.len().div_ceil(rows)).map(|_| None).collect(),
+        };
+        pos.par_chunks_mut(rows)
+            .zip(weight_bands)
+            .zip(made.par_chunks_mut(across))
+            .enumerate()
+            .for_each(|(row, ((out, weights), made))| {
+                let y1 = self.window.y1 + row as i32 * BLOCK;
+                let mut band = Band {
+                    setup: self,
+                    y1,
+                    y2: (y1 + BLOCK).min(self.window.y2),
+                    out,
+                    weights,
+                    scratch: Scratch::default(),
+                };
+                f(&mut band, row * across, made);
+            });
+    }
+}
+
+/// Evaluates every block of `band` afresh ([`Block::fill`]).
+pub(super) fn fill_band(band: &mut Band, made: &mut [bool]) {
+    for (k, made) in made.iter_mut().enumerate() {
+        *made = band.block(k).fill();
+    }
+}
+
+/// A row of blocks of the map being made.
+pub(super) struct Band<'a> {
+    pub setup: &'a Setup<'a>,
+    pub y1: i32,
+    pub y2: i32,
+    /// The band's rows of the map.
+    out: &'a mut [[f32; 2]],
+    /// The same rows of `Σ w` per pixel, when kept.
+    weights: Option<&'a mut [f32]>,
+    scratch: Scratch,
+}
+
+impl Band<'_> {
+    /// Block `k` of the band, from the left.
+    pub fn block(&mut self, k: usize) -> Block<'_> {
+        let window = self.setup.window;
+        let x1 = window.x1 + k as i32 * BLOCK;
+        Block {
+            setup: self.setup,
+            rect: RectI::new(x1, self.y1, (x1 + BLOCK).min(window.x2), self.y2),
+            out: &mut *self.out,
+            weights: self.weights.as_deref_mut(),
+            scratch: &mut self.scratch,
+        }
+    }
+
+    /// Pixels `x1..x2` of row `j`: positions and `Σ w` (when kept).
+    pub fn row_mut(&mut self, j: i32, x1: i32, x2: i32) -> (&mut [[f32; 2]], Option<&mut [f32]>) {
+        let window = self.setup.window;
+        let start = (j - self.y1) as usize * window.width() + (x1 - window.x1) as usize;
+        let n = (x2 - x1) as usize;
+        let weights = self
+            .weights
+            .as_deref_mut()
+            .map(|w| &mut w[start..start + n]);
+        (&mut self.out[start..start + n], weights)
+    }
+}
+
+/// One block of the map being made.
+pub(super) struct Block<'a> {
+    pub setup: &'a Setup<'a>,
+    /// The block's pixels.
+    pub rect: RectI,
     /// The band of the map this block lies in (rows from the block's `y1`).
     out: &'a mut [[f32; 2]],
+    /// The same band of `Σ w` per pixel, when kept.
+    weights: Option<&'a mut [f32]>,
     scratch: &'a mut Scratch,
 }
 
@@ -93,10 +199,8 @@ struct Scratch {
     ys: Vec<f32>,
     ox: Vec<f32>,
     oy: Vec<f32>,
-    /// Far sums along a row, one vector per component, padded to whole lanes.
-    far: [Vec<f32>; 3],
-    /// Far sums interpolated along each grid row: `[(row * 3 + m) * stride + k]`.
-    across: Vec<f32>,
+    ow: Vec<f32>,
+    far: FarRows,
     sets: Sets,
 }
 
@@ -111,16 +215,19 @@ struct Sets {
 }
 
 impl Block<'_> {
-    fn fill(&mut self, segments: &[(Vec2, Vec2)], tol: [f32; 2]) {
-        let b = self.block;
-        let (lo, hi) = (
-            Vec2::new(b.x1 as f64 + 0.5, b.y1 as f64 + 0.5),
-            Vec2::new(b.x2 as f64 - 0.5, b.y2 as f64 - 0.5),
-        );
+    /// Evaluates the block: near lines exactly, far ones from a grid when
+    /// that passes the checks, else all exactly. Whether the far field was
+    /// interpolated.
+    pub fn fill(&mut self) -> bool {
+        if self.setup.tol.is_none() {
+            self.exact();
+            return false;
+        }
+        let (lo, hi) = self.corners();
         let mut sets = std::mem::take(&mut self.scratch.sets);
         sets.near_idx.clear();
         sets.far_idx.clear();
-        for (k, &(p, q)) in segments.iter().enumerate() {
+        for (k, &(p, q)) in self.setup.segments.iter().enumerate() {
             if is_near(p, q, lo, hi) {
                 sets.near_idx.push(k);
             } else {
@@ -130,40 +237,73 @@ impl Block<'_> {
         if sets.far_idx.is_empty() {
             self.scratch.sets = sets;
             self.exact();
-            return;
+            return false;
         }
-        let all = &self.warp.kernel;
+        let all = &self.setup.warp.kernel;
         all.select_into(&sets.far_idx, &mut sets.far);
         all.select_into(&sets.near_idx, &mut sets.near);
         let grid = self.far_grid(&sets.far);
-        self.interpolated(&sets.near, &grid);
+        self.rows(&sets.near, Some(&grid));
         self.scratch.sets = sets;
-        if !self.checks_pass(tol) {
-            self.exact();
+        if self.checks_pass() {
+            return true;
         }
+        self.exact();
+        false
+    }
+
+    /// The centres of the block's corner pixels (pixel space).
+    fn corners(&self) -> (Vec2, Vec2) {
+        let b = self.rect;
+        (
+            Vec2::new(b.x1 as f64 + 0.5, b.y1 as f64 + 0.5),
+            Vec2::new(b.x2 as f64 - 0.5, b.y2 as f64 - 0.5),
+        )
+    }
+
+    /// Whether segment `p→q` (pixel space) is near enough to this block to
+    /// be among its exactly evaluated lines.
+    pub fn is_near(&self, (p, q): (Vec2, Vec2)) -> bool {
+        let (lo, hi) = self.corners();
+        is_near(p, q, lo, hi)
     }
 
     /// Canonical position of the centre of pixel `(i, j)`.
     fn centre(&self, i: i32, j: i32) -> (f32, f32) {
-        let c = self.scale.pixel_centre(i, j);
+        let c = self.setup.scale.pixel_centre(i, j);
         (c.x as f32, c.y as f32)
     }
 
+    /// Where row `j` of the block starts in its band.
+    fn row_start(&self, j: i32) -> usize {
+        let w = self.setup.window.width();
+        (j - self.rect.y1) as usize * w + (self.rect.x1 - self.setup.window.x1) as usize
+    }
+
     fn row_mut(&mut self, j: i32) -> &mut [[f32; 2]] {
-        let w = self.window.width();
-        let start = (j - self.block.y1) as usize * w + (self.block.x1 - self.window.x1) as usize;
-        &mut self.out[start..start + self.block.width()]
+        let start = self.row_start(j);
+        &mut self.out[start..start + self.rect.width()]
+    }
+
+    /// Row `j`'s positions and, when kept, its `Σ w`.
+    fn rows_mut(&mut self, j: i32) -> (&mut [[f32; 2]], Option<&mut [f32]>) {
+        let (start, n) = (self.row_start(j), self.rect.width());
+        let weights = self
+            .weights
+            .as_deref_mut()
+            .map(|w| &mut w[start..start + n]);
+        (&mut self.out[start..start + n], weights)
     }
 
     /// Every pixel of the block with all lines.
     fn exact(&mut self) {
-        self.rows(&self.warp.kernel, None);
+        self.rows(&self.setup.warp.kernel, None);
     }
 
-    /// The far lines' sums on grid nodes `(x1 + a·GRID, y1 + c·GRID)`, which
+    /// `lines`' sums on grid nodes `(x1 + a·GRID, y1 + c·GRID)`, which
     /// reach up to one cell past the block's far edges.
-    fn far_grid(&self, far: &Lines) -> Grid {
-        let b = self.block;
+    fn far_grid(&self, lines: &Lines) -> Grid {
+        let b = self.rect;
         let nx = (b.width() as i32 + GRID - 1) / GRID + 1;
         let ny = (b.height() as i32 + GRID - 1) / GRID + 1;
         let (mut xs, mut ys) = (Vec::new(), Vec::new());
@@ -175,70 +315,41 @@ impl Block<'_> {
             }
         }
         let mut sums = vec![[0f32; 3]; xs.len()];
-        far.sums(&xs, &ys, &mut sums);
+        lines.sums(&xs, &ys, &mut sums);
         Grid {
             nx: nx as usize,
             sums,
         }
     }
 
-    /// Near lines exactly plus the far field interpolated from `grid`.
-    fn interpolated(&mut self, near: &Lines, grid: &Grid) {
-        self.rows(near, Some(grid));
+    /// The centres' x of the block's pixels along a row, into `scratch.xs`.
+    fn row_xs(&mut self) {
+        let (b, scale) = (self.rect, self.setup.scale);
+        self.scratch.xs.clear();
+        (self.scratch.xs).extend((b.x1..b.x2).map(|i| scale.pixel_centre(i, b.y1).x as f32));
     }
 
     /// Each row of the block through `lines`, plus the far field from `grid`
     /// when there is one.
     fn rows(&mut self, lines: &Lines, grid: Option<&Grid>) {
-        let b = self.block;
+        let b = self.rect;
         let n = b.width();
+        self.row_xs();
         let mut sc = std::mem::take(self.scratch);
-        sc.xs.clear();
-        sc.xs.extend((b.x1..b.x2).map(|i| self.centre(i, b.y1).0));
-        for v in [&mut sc.ys, &mut sc.ox, &mut sc.oy] {
+        for v in [&mut sc.ys, &mut sc.ox, &mut sc.oy, &mut sc.ow] {
             v.resize(n, 0.0);
         }
-        for v in &mut sc.far {
-            v.clear();
-            v.resize(n + 8, 0.0);
+        match grid {
+            Some(grid) => sc.far.across(grid, n),
+            None => sc.far.zero(n),
         }
-        // The far sums along each grid row, interpolated across once per
-        // block; each pixel row then blends the two grid rows around it, a
-        // loop over whole rows that vectorises.
-        let stride = n + 8;
-        if let Some(grid) = grid {
-            let ny = grid.sums.len() / grid.nx;
-            sc.across.clear();
-            sc.across.resize(ny * 3 * stride, 0.0);
-            for (c, nodes) in grid.sums.chunks_exact(grid.nx).enumerate() {
-                for m in 0..3 {
-                    let row = &mut sc.across[(c * 3 + m) * stride..(c * 3 + m + 1) * stride];
-                    for (cell, w) in row.chunks_exact_mut(GRID as usize).zip(nodes.windows(2)) {
-                        let (a, d) = (w[0][m], w[1][m] - w[0][m]);
-                        for (o, f) in cell.iter_mut().zip(FRACTIONS) {
-                            *o = a + d * f;
-                        }
-                    }
-                }
-            }
-        }
+        let keep_weights = self.weights.is_some();
         for j in b.y1..b.y2 {
             sc.ys.fill(self.centre(b.x1, j).1);
-            if grid.is_some() {
-                let dy = (j - b.y1) as usize;
-                let (c, f) = (
-                    dy / GRID as usize,
-                    (dy % GRID as usize) as f32 / GRID as f32,
-                );
-                for (m, far) in sc.far.iter_mut().enumerate() {
-                    let lo = &sc.across[(c * 3 + m) * stride..(c * 3 + m + 1) * stride];
-                    let hi = &sc.across[((c + 1) * 3 + m) * stride..((c + 1) * 3 + m + 1) * stride];
-                    for ((o, a), b) in far.iter_mut().zip(lo).zip(hi) {
-                        *o = a + (b - a) * f;
-                    }
-                }
-            }
-            let far = &sc.far;
+            let far = match grid {
+                Some(_) => sc.far.row((j - b.y1) as usize),
+                None => &sc.far.row,
+            };
             let lanes = |k: usize| {
                 let lane = |m: usize| f32x8::new(far[m][k..k + 8].try_into().expect("8 lanes"));
                 Sums {
@@ -247,9 +358,14 @@ impl Block<'_> {
                     w: lane(2),
                 }
             };
-            lines.map_points_plus(&sc.xs, &sc.ys, lanes, &mut sc.ox, &mut sc.oy);
-            for (o, (x, y)) in self.row_mut(j).iter_mut().zip(sc.ox.iter().zip(&sc.oy)) {
+            let ow = keep_weights.then_some(&mut sc.ow[..]);
+            lines.map_points_plus(&sc.xs, &sc.ys, lanes, (&mut sc.ox, &mut sc.oy), ow);
+            let (out, weights) = self.rows_mut(j);
+            for (o, (x, y)) in out.iter_mut().zip(sc.ox.iter().zip(&sc.oy)) {
                 *o = [*x, *y];
+            }
+            if let Some(w) = weights {
+                w.copy_from_slice(&sc.ow);
             }
         }
         *self.scratch = sc;
@@ -257,8 +373,11 @@ impl Block<'_> {
 
     /// Compares the block with the exact map at the centres of every other
     /// grid cell (where bilinear interpolation errs most).
-    fn checks_pass(&mut self, tol: [f32; 2]) -> bool {
-        let b = self.block;
+    fn checks_pass(&mut self) -> bool {
+        let Some(tol) = self.setup.tol else {
+            return true;
+        };
+        let b = self.rect;
         let mut pixels = Vec::new();
         let mut j = b.y1 + GRID / 2;
         while j < b.y2 {
@@ -271,7 +390,10 @@ impl Block<'_> {
         }
         let (xs, ys): (Vec<f32>, Vec<f32>) = pixels.iter().map(|&(i, j)| self.centre(i, j)).unzip();
         let (mut ox, mut oy) = (vec![0f32; xs.len()], vec![0f32; xs.len()]);
-        self.warp.kernel.map_points(&xs, &ys, &mut ox, &mut oy);
+        self.setup
+            .warp
+            .kernel
+            .map_points(&xs, &ys, &mut ox, &mut oy);
         pixels.iter().enumerate().all(|(k, &(i, j))| {
             let got = self.row_mut(j)[(i - b.x1) as usize];
             (got[0] - ox[k]).abs() <= tol[0] && (got[1] - oy[k]).abs() <= tol[1]
@@ -279,10 +401,70 @@ impl Block<'_> {
     }
 }
 
-/// Far-field sums on a grid of `nx` nodes per row.
+/// Sums on a grid of `nx` nodes per row.
 struct Grid {
     nx: usize,
     sums: Vec<[f32; 3]>,
+}
+
+/// A grid's sums interpolated over a block: along each grid row once per
+/// block, then between two grid rows per pixel row, loops over whole rows
+/// that vectorise.
+#[derive(Default)]
+struct FarRows {
+    /// Sums along each grid row: `[(row * 3 + m) * stride + k]`.
+    across: Vec<f32>,
+    stride: usize,
+    /// One pixel row's sums, one vector per component, padded to whole lanes.
+    row: [Vec<f32>; 3],
+}
+
+impl FarRows {
+    /// Interpolates `grid` along its rows for a block `n` pixels wide.
+    fn across(&mut self, grid: &Grid, n: usize) {
+        self.zero(n);
+        let ny = grid.sums.len() / grid.nx;
+        self.across.clear();
+        self.across.resize(ny * 3 * self.stride, 0.0);
+        for (c, nodes) in grid.sums.chunks_exact(grid.nx).enumerate() {
+            for m in 0..3 {
+                let at = (c * 3 + m) * self.stride;
+                let row = &mut self.across[at..at + self.stride];
+                for (cell, w) in row.chunks_exact_mut(GRID as usize).zip(nodes.windows(2)) {
+                    let (a, d) = (w[0][m], w[1][m] - w[0][m]);
+                    for (o, f) in cell.iter_mut().zip(FRACTIONS) {
+                        *o = a + d * f;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Rows of zeros for a block `n` pixels wide (no far field).
+    fn zero(&mut self, n: usize) {
+        self.stride = n + 8;
+        for v in &mut self.row {
+            v.clear();
+            v.resize(self.stride, 0.0);
+        }
+    }
+
+    /// The sums along pixel row `dy` of the block.
+    fn row(&mut self, dy: usize) -> &[Vec<f32>; 3] {
+        let (c, f) = (
+            dy / GRID as usize,
+            (dy % GRID as usize) as f32 / GRID as f32,
+        );
+        let stride = self.stride;
+        for (m, far) in self.row.iter_mut().enumerate() {
+            let lo = &self.across[(c * 3 + m) * stride..][..stride];
+            let hi = &self.across[((c + 1) * 3 + m) * stride..][..stride];
+            for ((o, a), b) in far.iter_mut().zip(lo).zip(hi) {
+                *o = a + (b - a) * f;
+            }
+        }
+        &self.row
+    }
 }
 
 /// Whether segment `p→q` comes within [`NEAR`] of the box `[lo, hi]`. Most

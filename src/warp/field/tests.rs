@@ -3,11 +3,11 @@ use crate::features::{Feature, FeatureKind, Side};
 use crate::warp::Warp;
 use proptest::prelude::*;
 
-fn v(x: f64, y: f64) -> Vec2 {
+pub(super) fn v(x: f64, y: f64) -> Vec2 {
     Vec2::new(x, y)
 }
 
-fn exact(a: f64) -> FieldSettings {
+pub(super) fn exact(a: f64) -> FieldSettings {
     FieldSettings {
         a,
         evaluation: Evaluation::Exact,
@@ -217,7 +217,7 @@ fn adaptive_mode_stays_within_its_tolerance_on_random_line_sets() {
 
 /// Long lines spread over a wide frame, many of them: every block mixes
 /// near and far lines, the case the adaptive split exists for.
-fn spread_pairs(seed: u64, n: usize, w: f64, h: f64) -> Vec<LinePair> {
+pub(super) fn spread_pairs(seed: u64, n: usize, w: f64, h: f64) -> Vec<LinePair> {
     let mut r = uniform(seed.wrapping_add(0x9E37_79B9_7F4A_7C15));
     (0..n)
         .map(|_| {

@@ -1,0 +1,134 @@
+//! Redone field maps against fresh and exact ones.
+
+use super::tests::{exact, spread_pairs, v};
+use super::*;
+use crate::warp::Warp;
+
+fn adaptive() -> FieldSettings {
+    FieldSettings {
+        evaluation: Evaluation::Adaptive {
+            tolerance: Evaluation::DEFAULT_TOLERANCE,
+        },
+        ..exact(0.001)
+    }
+}
+
+/// Line `k` with its destination and source start moved by `by`, as
+/// dragging a line's A end moves the in-between line and A's.
+fn drag(pairs: &[LinePair], k: usize, by: Vec2) -> Vec<LinePair> {
+    let mut pairs = pairs.to_vec();
+    pairs[k].dst.0 += by * 0.5;
+    pairs[k].src.0 += by;
+    pairs
+}
+
+/// The largest distance between the two maps' positions, in output pixels.
+fn worst_px(a: &WarpMap, b: &WarpMap) -> f64 {
+    assert_eq!((a.window, a.scale), (b.window, b.scale));
+    let mut worst = 0.0f64;
+    for j in a.window.y1..a.window.y2 {
+        for i in a.window.x1..a.window.x2 {
+            let (pa, pb) = (a.scale.to_pixel(a.get(i, j)), a.scale.to_pixel(b.get(i, j)));
+            worst = worst.max(pa.distance(pb));
+        }
+    }
+    worst
+}
+
+fn window_at(scale: f64) -> (RectI, PixelScale) {
+    let s = PixelScale::new(scale, scale, 1.0);
+    (
+        RectI::new(0, 0, (640.0 * scale) as i32, (360.0 * scale) as i32),
+        s,
+    )
+}
+
+#[test]
+fn a_full_field_map_is_map_window_bit_for_bit() {
+    let (window, scale) = window_at(1.0);
+    for settings in [adaptive(), exact(0.001)] {
+        let warp = FieldWarp::new(spread_pairs(4, 30, 640.0, 360.0), &settings);
+        let kept = warp.field_map(window, scale);
+        assert_eq!(kept.redos(), 0);
+        assert_eq!(**kept.map(), warp.map_window(window, scale));
+    }
+}
+
+#[test]
+fn redos_while_a_line_is_dragged_stay_within_tolerance_of_the_exact_map() {
+    let tolerance = Evaluation::DEFAULT_TOLERANCE;
+    for (seed, n, scale) in [(1, 60, 1.0), (2, 40, 0.5), (5, 4, 1.0)] {
+        let (window, scale) = window_at(scale);
+        let mut pairs = spread_pairs(seed, n, 640.0, 360.0);
+        let mut kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+        for step in 1..=4 {
+            pairs = drag(&pairs, step % n, v(3.0, -2.0));
+            let warp = FieldWarp::new(pairs.clone(), &adaptive());
+            kept = warp.field_map_after(window, scale, Some(&kept));
+            assert_eq!(
+                kept.redos(),
+                step as u32,
+                "seed {seed}: a redo, not a fresh map"
+            );
+            let truth = FieldWarp::new(pairs.clone(), &exact(0.001)).map_window(window, scale);
+            let err = worst_px(kept.map(), &truth);
+            assert!(
+                err <= tolerance,
+                "seed {seed}, {n} lines, scale {}, drag {step}: {err} px from exact > {tolerance}",
+                scale.x
+            );
+        }
+    }
+}
+
+#[test]
+fn an_exact_redo_matches_the_fresh_exact_map() {
+    let (window, scale) = window_at(1.0);
+    let mut pairs = spread_pairs(3, 50, 640.0, 360.0);
+    let mut kept = FieldWarp::new(pairs.clone(), &exact(0.001)).field_map(window, scale);
+    for step in 1..=10 {
+        pairs = drag(&pairs, 7, v(-1.0, 2.5));
+        let warp = FieldWarp::new(pairs.clone(), &exact(0.001));
+        kept = warp.field_map_after(window, scale, Some(&kept));
+        assert_eq!(kept.redos(), step);
+        let err = worst_px(kept.map(), &warp.map_window(window, scale));
+        assert!(err < 1e-3, "drag {step}: {err} px from the fresh exact map");
+    }
+}
+
+#[test]
+fn maps_are_made_afresh_when_the_setup_or_many_lines_change() {
+    let (window, scale) = window_at(1.0);
+    let pairs = spread_pairs(6, 20, 640.0, 360.0);
+    let kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+    let one_moved = drag(&pairs, 0, v(1.0, 0.0));
+    let redo = |pairs: &[LinePair], settings: &FieldSettings, window: RectI| {
+        FieldWarp::new(pairs.to_vec(), settings)
+            .field_map_after(window, scale, Some(&kept))
+            .redos()
+    };
+    assert_eq!(redo(&one_moved, &adaptive(), window), 1);
+    let six_moved = (0..6).fold(pairs.clone(), |p, k| drag(&p, k, v(1.0, 0.0)));
+    assert_eq!(
+        redo(&six_moved, &adaptive(), window),
+        0,
+        "over a quarter moved"
+    );
+    assert_eq!(
+        redo(&one_moved, &exact(0.001), window),
+        0,
+        "another evaluation"
+    );
+    let wider = FieldSettings {
+        b: 1.5,
+        ..adaptive()
+    };
+    assert_eq!(redo(&one_moved, &wider, window), 0, "another weight");
+    let tile = RectI::new(0, 0, 320, 360);
+    assert_eq!(redo(&one_moved, &adaptive(), tile), 0, "another window");
+    assert_eq!(
+        redo(&one_moved[1..], &adaptive(), window),
+        0,
+        "a line fewer"
+    );
+}
