@@ -49,6 +49,12 @@ impl Weigh for WarpMap {
     }
 }
 
+impl Weigh for morphfx::warp::field::FieldMap {
+    fn bytes(&self) -> usize {
+        self.memory_bytes()
+    }
+}
+
 impl Weigh for morphfx::transition::Weights {
     fn bytes(&self) -> usize {
         self.memory_bytes()

@@ -1,12 +1,14 @@
 //! Per-instance state: the warp cache, the parsed scene, messages said once.
 
 use std::collections::HashSet;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
 
+use morphfx::features::Side;
 use morphfx::image::Plane;
 use morphfx::scene::Scene;
 use morphfx::transition::Weights;
 use morphfx::warp::auto::{Correspondence, Grid};
+use morphfx::warp::field::FieldMap;
 use morphfx::warp::thin_plate::ThinPlate;
 
 use super::NodeKind;
@@ -21,6 +23,12 @@ pub struct NodeState {
     /// The instance's params, their handles fetched once at creation.
     params: Params,
     pub warps: WarpCache,
+    /// Viewer renders' `field` maps with the sums that redo them after a
+    /// line moves, keyed like the warps.
+    pub field_maps: Cache<FieldMap>,
+    /// Each side's last field map, while the cache holds it: what the next
+    /// viewer render redoes.
+    last_field: Mutex<[Weak<FieldMap>; 2]>,
     /// The last scene parsed, keyed by where it came from (text, or path + mtime + size).
     pub scene: Mutex<Option<(String, Arc<Scene>)>>,
     /// Warnings already posted (minimal hosts: report each fallback once).
@@ -62,6 +70,8 @@ impl NodeState {
             context,
             params,
             warps: Default::default(),
+            field_maps: Default::default(),
+            last_field: Default::default(),
             scene: Default::default(),
             said: Default::default(),
             planes: Default::default(),
@@ -86,6 +96,7 @@ impl NodeState {
     /// keep memory flat).
     pub fn purge(&self) {
         self.warps.clear();
+        self.field_maps.clear();
         *self.scene.lock().unwrap_or_else(|e| e.into_inner()) = None;
         self.planes
             .lock()
@@ -95,11 +106,30 @@ impl NodeState {
         self.weights.clear();
     }
 
+    /// `side`'s last field map, if the cache still holds it.
+    pub fn last_field(&self, side: Side) -> Option<Arc<FieldMap>> {
+        let last = self.last_field.lock().unwrap_or_else(|e| e.into_inner());
+        last[side_index(side)].upgrade()
+    }
+
+    /// Makes `map` the one the next viewer render of `side` redoes.
+    pub fn set_last_field(&self, side: Side, map: &Arc<FieldMap>) {
+        let mut last = self.last_field.lock().unwrap_or_else(|e| e.into_inner());
+        last[side_index(side)] = Arc::downgrade(map);
+    }
+
     /// True the first time `what` is asked about.
     pub fn first_time(&self, what: &str) -> bool {
         self.said
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .insert(what.to_owned())
+    }
+}
+
+fn side_index(side: Side) -> usize {
+    match side {
+        Side::A => 0,
+        Side::B => 1,
     }
 }

@@ -389,6 +389,9 @@ fn map(
 ) -> Outcome<Arc<WarpMap>> {
     let (inputs, scale) = (&request.inputs, request.out_scale);
     let key = Key::of(&(inputs, side, window, scale));
+    if inputs.warp.method() == Method::Field && !request.sequential {
+        return field_map(instance, request, side, window, key);
+    }
     instance.warps.get_or_compute(key, || {
         let w: Arc<dyn Warp> = if inputs.warp.method() == Method::ThinPlate {
             let when = (request.time, request.sequential);
@@ -398,6 +401,27 @@ fn map(
         };
         Ok::<_, Failure>(w.map_window(window, scale))
     })
+}
+
+/// A viewer render's `field` map: redone from this side's last one when a
+/// few lines moved since (a compositor dragging one), else made afresh.
+/// Renders in sequence (to disk, on a farm) never come here: a file does
+/// not depend on what a viewer showed before it.
+fn field_map(
+    instance: &NodeState,
+    request: &Request,
+    side: Side,
+    window: RectI,
+    key: Key,
+) -> Outcome<Arc<WarpMap>> {
+    let inputs = &request.inputs;
+    let kept = instance.field_maps.get_or_compute(key, || {
+        let warp = make_warp::field_toward(&inputs.features, side, inputs.t, &inputs.warp)?;
+        let before = instance.last_field(side);
+        Ok::<_, Failure>(warp.field_map_after(window, request.out_scale, before.as_deref()))
+    })?;
+    instance.set_last_field(side, &kept);
+    Ok(kept.map().clone())
 }
 
 /// The per-pixel dissolve weights of a non-uniform colour transition.
