@@ -153,44 +153,52 @@ impl Lines {
         );
     }
 
-    /// The sums per point into one slice per component, each padded to
-    /// whole lanes (at least `xs.len()` rounded up to 8 long).
-    pub fn sums_into(&self, xs: &[f32], ys: &[f32], [sx, sy, sw]: [&mut [f32]; 3]) {
-        let zero = Sums::default();
-        self.each8(
-            xs,
-            ys,
-            |_| zero,
-            |k, _, _, _, s| {
-                sx[k..k + 8].copy_from_slice(&s.x.to_array());
-                sy[k..k + 8].copy_from_slice(&s.y.to_array());
-                sw[k..k + 8].copy_from_slice(&s.w.to_array());
-            },
-        );
+    /// At each point, `after`'s sums less these lines' (`[Σ w·Δx, Σ w·Δy,
+    /// Σ w]`), and these lines' `Σ w`, into four slices padded to whole
+    /// lanes (at least `xs.len()` rounded up to 8 long). Both sets share
+    /// one pass, so their dependency chains overlap.
+    pub fn change_to(&self, after: &Lines, xs: &[f32], ys: &[f32], out: [&mut [f32]; 4]) {
+        match self.exponent.unwrap_or(Exponent::One) {
+            Exponent::Zero => self.change_with(|_| f32x8::ONE, after, xs, ys, out),
+            Exponent::Half => self.change_with(|r| r.sqrt(), after, xs, ys, out),
+            Exponent::One => self.change_with(|r| r, after, xs, ys, out),
+            Exponent::Two => self.change_with(|r| r * r, after, xs, ys, out),
+            Exponent::General(b) => {
+                let b = f32x8::splat(b);
+                self.change_with(move |r| (r.ln() * b).exp(), after, xs, ys, out)
+            }
+        }
     }
 
-    /// These lines' sums per point less `before` (sums laid out as
-    /// [`Lines::sums_into`] writes them), into `out` likewise.
-    pub fn sums_less(
+    #[inline(always)]
+    fn change_with<F: Fn(f32x8) -> f32x8>(
         &self,
+        pow: F,
+        after: &Lines,
         xs: &[f32],
         ys: &[f32],
-        before: [&[f32]; 3],
-        [sx, sy, sw]: [&mut [f32]; 3],
+        [dx, dy, dw, old_w]: [&mut [f32]; 4],
     ) {
-        let less = |k: usize| {
-            let lane = |m: usize| -f32x8::new(before[m][k..k + 8].try_into().expect("8 lanes"));
-            Sums {
-                x: lane(0),
-                y: lane(1),
-                w: lane(2),
-            }
-        };
-        self.each8(xs, ys, less, |k, _, _, _, s| {
-            sx[k..k + 8].copy_from_slice(&s.x.to_array());
-            sy[k..k + 8].copy_from_slice(&s.y.to_array());
-            sw[k..k + 8].copy_from_slice(&s.w.to_array());
-        });
+        let mut k = 0;
+        while k < xs.len() {
+            let take = (xs.len() - k).min(8);
+            let (mut bx, mut by) = ([0f32; 8], [0f32; 8]);
+            bx[..take].copy_from_slice(&xs[k..k + take]);
+            by[..take].copy_from_slice(&ys[k..k + take]);
+            let (x, y) = (f32x8::new(bx), f32x8::new(by));
+            let old = self.sums8(&pow, x, y, Sums::default());
+            let less = Sums {
+                x: -old.x,
+                y: -old.y,
+                w: -old.w,
+            };
+            let change = after.sums8(&pow, x, y, less);
+            dx[k..k + 8].copy_from_slice(&change.x.to_array());
+            dy[k..k + 8].copy_from_slice(&change.y.to_array());
+            dw[k..k + 8].copy_from_slice(&change.w.to_array());
+            old_w[k..k + 8].copy_from_slice(&old.w.to_array());
+            k += take;
+        }
     }
 
     /// Runs the kernel over points eight at a time: `sink(k, take, x, y, sums)`.

@@ -197,8 +197,7 @@ impl<'a> Moved<'a> {
             .collect();
         let padded = xs.len().div_ceil(8) * 8 + 8;
         let mut ys = vec![0f32; xs.len()];
-        let mut old: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0f32; padded]);
-        let mut change: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0f32; padded]);
+        let mut change: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0f32; padded]);
         for j in band.y1..band.y2 {
             let y = scale.pixel_centre(window.x1, j).y as f32;
             ys.fill(y);
@@ -213,14 +212,11 @@ impl<'a> Moved<'a> {
                 }
                 let cols = block_columns(k, xs.len());
                 let (xs, ys) = (&xs[cols.clone()], &ys[cols.clone()]);
-                self.old
-                    .sums_into(xs, ys, old.each_mut().map(|v| &mut v[..]));
-                let before = old.each_ref().map(|v| &v[..]);
-                (self.new).sums_less(xs, ys, before, change.each_mut().map(|v| &mut v[..]));
+                let change_out = change.each_mut().map(|v| &mut v[..]);
+                (self.old).change_to(&self.new, xs, ys, change_out);
                 let was = (&was[cols.clone()], &was_w[cols.clone()]);
                 let out = (&mut out[cols.clone()], &mut weights[cols.clone()]);
-                let delta = [&change[0][..], &change[1][..], &change[2][..], &old[2][..]];
-                if !swap_terms(xs, y, was, delta, out) {
+                if !swap_terms(xs, y, was, change.each_ref().map(|v| &v[..]), out) {
                     *fresh = true;
                 }
             }
