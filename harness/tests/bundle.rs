@@ -216,6 +216,7 @@ fn render_morph(case: &Case) -> (Image, Image, Image) {
         // The plugin's own pixels, compared with the core's.
         identity: false,
         sequential: false,
+        interactive: false,
         window: None,
     };
     inst.begin_sequence(1.0, 1.0).unwrap();

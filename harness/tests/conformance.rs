@@ -73,6 +73,7 @@ const OWN_PIXELS: OutputSpec = OutputSpec {
     tiles: 1,
     identity: false,
     sequential: false,
+    interactive: false,
     window: None,
 };
 

@@ -1,7 +1,7 @@
-//! Dragging a line in a viewer: renders after each move redo the `field`
-//! maps from the last ones (through the plugin and its caches), stay within
-//! the adaptive tolerance of the exact map, and leave renders in sequence (to
-//! disk) exactly what a fresh instance makes.
+//! Dragging a line in a viewer: interactive renders after each move redo
+//! the `field` maps from the last ones (through the plugin and its caches),
+//! stay within the adaptive tolerance of the exact map, and leave every other
+//! render (on demand or in sequence) exactly what a fresh instance makes.
 
 use std::sync::Arc;
 
@@ -72,11 +72,23 @@ fn instance(view: &str) -> Instance<'static> {
     inst
 }
 
-fn render(inst: &Instance<'_>, text: &str, sequential: bool) -> Image {
+/// How a host asks for a render.
+#[derive(Clone, Copy, Debug)]
+enum Render {
+    /// For a viewer while the instance is manipulated (interactive).
+    Viewer,
+    /// Neither interactive nor in sequence: a host's frame on demand.
+    Plain,
+    /// Frame after frame in order, to disk.
+    Sequence,
+}
+
+fn render(inst: &Instance<'_>, text: &str, how: Render) -> Image {
     inst.set_string("scene_text", text).unwrap();
     let spec = OutputSpec {
         identity: false,
-        sequential,
+        interactive: matches!(how, Render::Viewer),
+        sequential: matches!(how, Render::Sequence),
         ..OutputSpec::default()
     };
     inst.render(1.0, spec).unwrap().to_image()
@@ -99,31 +111,37 @@ fn viewer_renders_while_a_line_is_dragged_stay_within_tolerance_of_the_exact_map
         let viewer = instance(view);
         let exact = instance(view);
         let fresh = instance(view);
-        render(&viewer, &scene(0.0, "adaptive"), false);
+        render(&viewer, &scene(0.0, "adaptive"), Render::Viewer);
         for step in 1..=3 {
             let dx = 1.5 * step as f64;
-            let dragged = render(&viewer, &scene(dx, "adaptive"), false);
-            let truth = render(&exact, &scene(dx, "exact"), false);
+            let dragged = render(&viewer, &scene(dx, "adaptive"), Render::Viewer);
+            let truth = render(&exact, &scene(dx, "exact"), Render::Plain);
             let err = worst_px(&dragged, &truth);
             assert!(
                 err <= TOLERANCE,
                 "{view}, drag {step}: {err} px from the exact map"
             );
             // A fresh adaptive map rounds differently: the viewer's was redone.
-            let made_afresh = render(&fresh, &scene(dx, "adaptive"), true);
+            let made_afresh = render(&fresh, &scene(dx, "adaptive"), Render::Plain);
             assert_ne!(dragged.data, made_afresh.data, "{view}, drag {step}");
         }
     }
 }
 
 #[test]
-fn renders_in_sequence_do_not_depend_on_what_a_viewer_rendered_before() {
-    let viewer = instance("morph");
-    for step in 0..3 {
-        render(&viewer, &scene(2.0 * step as f64, "adaptive"), false);
+fn other_renders_do_not_depend_on_what_a_viewer_rendered_before() {
+    for how in [Render::Plain, Render::Sequence] {
+        let viewer = instance("morph");
+        for step in 0..3 {
+            render(
+                &viewer,
+                &scene(2.0 * step as f64, "adaptive"),
+                Render::Viewer,
+            );
+        }
+        let text = scene(6.0, "adaptive");
+        let after_drags = render(&viewer, &text, how);
+        let fresh = render(&instance("morph"), &text, how);
+        assert_eq!(after_drags.data, fresh.data, "{how:?}");
     }
-    let text = scene(6.0, "adaptive");
-    let after_drags = render(&viewer, &text, true);
-    let fresh = render(&instance("morph"), &text, true);
-    assert_eq!(after_drags.data, fresh.data);
 }

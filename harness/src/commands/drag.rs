@@ -100,6 +100,8 @@ pub fn drag(
         let spec = OutputSpec {
             render_scale: (scale, scale),
             identity: false,
+            // A viewer's render while the line is dragged.
+            interactive: true,
             ..OutputSpec::default()
         };
         let time = |f: &mut dyn FnMut() -> Result<(), HostError>| -> Result<f64, HostError> {

@@ -107,6 +107,9 @@ pub struct OutputSpec {
     /// This host renders the sequence in frame order on this instance
     /// (kOfxImageEffectPropSequentialRenderStatus = 1).
     pub sequential: bool,
+    /// A viewer's render while the instance is manipulated
+    /// (kOfxImageEffectPropInteractiveRenderStatus = 1).
+    pub interactive: bool,
     /// Host misuse: send this render window, whatever the output image
     /// covers (`None`: the image's bounds, in tiles).
     pub window: Option<RectI>,
@@ -122,6 +125,7 @@ impl Default for OutputSpec {
             tiles: 1,
             identity: true,
             sequential: false,
+            interactive: false,
             window: None,
         }
     }
@@ -779,7 +783,10 @@ impl Instance<'_> {
                 kOfxImageEffectPropSequentialRenderStatus,
                 &[spec.sequential as i32],
             );
-            a.set_int(kOfxImageEffectPropInteractiveRenderStatus, &[0]);
+            a.set_int(
+                kOfxImageEffectPropInteractiveRenderStatus,
+                &[spec.interactive as i32],
+            );
             self.act(kOfxImageEffectActionRender, Some(&a), None)
                 .map(|_| ())
         };

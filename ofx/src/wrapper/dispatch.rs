@@ -245,6 +245,10 @@ fn render_args(in_args: &PropSet) -> Outcome<RenderArgs> {
             .get_int(kOfxImageEffectPropSequentialRenderStatus, 0)
             .unwrap_or(0)
             == 1,
+        interactive: in_args
+            .get_int(kOfxImageEffectPropInteractiveRenderStatus, 0)
+            .unwrap_or(0)
+            == 1,
     })
 }
 

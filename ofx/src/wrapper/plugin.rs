@@ -98,6 +98,10 @@ pub struct RenderArgs {
     pub window: RectI,
     /// The host renders this instance's frames in order (warm starts allowed).
     pub sequential: bool,
+    /// The host renders for a viewer while the instance is being
+    /// manipulated, where the spec allows an approximation for UI purposes
+    /// (`kOfxImageEffectPropInteractiveRenderStatus`).
+    pub interactive: bool,
 }
 
 /// The clip (and its time) a node's output equals at some frame.

@@ -90,6 +90,9 @@ struct Request {
     window: RectI,
     /// The host renders frames in order on this instance (warm starts allowed).
     sequential: bool,
+    /// A viewer's render while the instance is manipulated (maps may be
+    /// redone from the last ones).
+    interactive: bool,
     settings: Settings,
     inputs: WarpInputs,
     /// Sources A and B (`None`: no image).
@@ -136,6 +139,7 @@ fn gather(
     args: &RenderArgs,
 ) -> Outcome<(Request, Lent)> {
     let (time, window, sequential) = (args.time, args.window, args.sequential);
+    let interactive = args.interactive;
     if window.area() > MAX_RENDER_PIXELS {
         // Maps and intermediate rows are sized by the window: refuse before
         // asking for memory no machine has (an allocation failure would
@@ -197,6 +201,7 @@ fn gather(
         time,
         window,
         sequential,
+        interactive,
         settings,
         inputs,
         sources,
@@ -389,7 +394,7 @@ fn map(
 ) -> Outcome<Arc<WarpMap>> {
     let (inputs, scale) = (&request.inputs, request.out_scale);
     let key = Key::of(&(inputs, side, window, scale));
-    if inputs.warp.method() == Method::Field && !request.sequential {
+    if inputs.warp.method() == Method::Field && request.interactive && !request.sequential {
         return field_map(instance, request, side, window, key);
     }
     instance.warps.get_or_compute(key, || {
@@ -403,10 +408,12 @@ fn map(
     })
 }
 
-/// A viewer render's `field` map: redone from this side's last one when a
-/// few lines moved since (a compositor dragging one), else made afresh.
-/// Renders in sequence (to disk, on a farm) never come here: a file does
-/// not depend on what a viewer showed before it.
+/// An interactive render's `field` map: redone from this side's last one
+/// when a few lines moved since (a compositor dragging one), else made
+/// afresh. The spec lets a plugin approximate for a viewer while the
+/// instance is manipulated (`kOfxImageEffectPropInteractiveRenderStatus`);
+/// every other render (to disk, on a farm, in sequence) makes its maps
+/// afresh, so a written frame never depends on what a viewer showed before.
 fn field_map(
     instance: &NodeState,
     request: &Request,
@@ -593,6 +600,7 @@ mod tests {
             time: 1.0,
             window: RectI::new(8, 8, 24, 20),
             sequential: false,
+            interactive: false,
             settings,
             inputs: WarpInputs { features, warp, t },
             sources: [source(true), source(true)],
