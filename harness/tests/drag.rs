@@ -9,6 +9,7 @@ mod common;
 
 use morphfx::geom::RectI;
 use morphfx::image::Image;
+use morphfx::testing::Lcg;
 use morphfx_harness::host::{Frame, Instance, OutputSpec};
 
 use common::{bundle, Still};
@@ -20,13 +21,8 @@ const TOLERANCE: f64 = 0.05;
 
 /// 24 lines over the frame, line 0's A start moved `dx` pixels right.
 fn scene(dx: f64, evaluation: &str) -> String {
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut lcg = Lcg::new(24);
+    let mut next = move || lcg.unit();
     let lines: Vec<serde_json::Value> = (0..24)
         .map(|k| {
             let (x, y) = (20.0 + 280.0 * next(), 15.0 + 150.0 * next());
