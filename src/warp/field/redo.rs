@@ -13,7 +13,7 @@
 use std::sync::Arc;
 
 use super::kernel::Lines;
-use super::split::{fill_band, Band, Setup, BLOCK};
+use super::split::{fill_band, Band, Setup};
 use super::weight::Weight;
 use super::{Evaluation, FieldWarp, LinePair};
 use crate::geom::{PixelScale, RectI, Vec2};
@@ -75,17 +75,17 @@ impl FieldWarp {
         scale: PixelScale,
         before: Option<&FieldMap>,
     ) -> FieldMap {
-        let mut kept = FieldMap {
-            map: Arc::new(WarpMap::identity(window, scale)),
-            weights: Vec::new(),
-            interpolated: Vec::new(),
+        let kept = |map: WarpMap, weights, interpolated, redos| FieldMap {
+            map: Arc::new(map),
+            weights,
+            interpolated,
             pairs: self.pairs.clone(),
             weight: self.weight,
             evaluation: self.evaluation,
-            redos: 0,
+            redos,
         };
         if self.identity {
-            return kept;
+            return kept(WarpMap::identity(window, scale), Vec::new(), Vec::new(), 0);
         }
         let tolerance = match self.evaluation {
             Evaluation::Exact => None,
@@ -95,7 +95,7 @@ impl FieldWarp {
         let mut pos = vec![[0f32; 2]; window.area()];
         let mut weights = vec![0f32; window.area()];
         let mut made = vec![false; setup.block_count()];
-        match before.and_then(|b| Moved::between(b, &setup)) {
+        let redos = match before.and_then(|b| Moved::between(b, &setup)) {
             Some(moved) => {
                 setup.each_band(
                     &mut pos,
@@ -103,16 +103,16 @@ impl FieldWarp {
                     &mut made,
                     |band, first, made| moved.redo(band, first, made),
                 );
-                kept.redos = moved.before.redos + 1;
+                moved.before.redos + 1
             }
-            None => setup.each_band(&mut pos, Some(&mut weights), &mut made, |band, _, made| {
-                fill_band(band, made)
-            }),
-        }
-        kept.map = Arc::new(WarpMap::new(window, scale, pos));
-        kept.weights = weights;
-        kept.interpolated = made;
-        kept
+            None => {
+                setup.each_band(&mut pos, Some(&mut weights), &mut made, |band, _, made| {
+                    fill_band(band, made)
+                });
+                0
+            }
+        };
+        kept(WarpMap::new(window, scale, pos), weights, made, redos)
     }
 }
 
@@ -188,7 +188,8 @@ impl<'a> Moved<'a> {
     /// untouched, and it moves the position by about as much while the
     /// total weight changes by a tenth or less, which [`swap_terms`] holds.
     fn shift(&self, band: &mut Band, fresh: &mut [bool]) {
-        let (window, scale) = (band.setup.window, band.setup.scale);
+        let setup = band.setup;
+        let (window, scale) = (setup.window, setup.scale);
         if fresh.iter().all(|&f| f) {
             return;
         }
@@ -204,13 +205,13 @@ impl<'a> Moved<'a> {
             let was = self.before.map.row(j).expect("a kept map has rows");
             let at = (j - window.y1) as usize * window.width();
             let was_w = &self.before.weights[at..at + window.width()];
-            let (out, weights) = band.row_mut(j, window.x1, window.x2);
+            let (out, weights) = band.row_mut(j);
             let weights = weights.expect("a redo keeps weights");
             for (k, fresh) in fresh.iter_mut().enumerate() {
                 if *fresh {
                     continue;
                 }
-                let cols = block_columns(k, xs.len());
+                let cols = setup.block_columns(k);
                 let (xs, ys) = (&xs[cols.clone()], &ys[cols.clone()]);
                 let change_out = change.each_mut().map(|v| &mut v[..]);
                 (self.old).change_to(&self.new, xs, ys, change_out);
@@ -222,12 +223,6 @@ impl<'a> Moved<'a> {
             }
         }
     }
-}
-
-/// The columns of block `k` of a band `width` pixels wide (from the window's left).
-fn block_columns(k: usize, width: usize) -> std::ops::Range<usize> {
-    let x1 = k * BLOCK as usize;
-    x1..(x1 + BLOCK as usize).min(width)
 }
 
 /// A row's positions and `Σ w` (`out`) from those before (`was`) with the

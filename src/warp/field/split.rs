@@ -18,7 +18,7 @@ use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
 
 /// Side of a block, pixels.
-pub(super) const BLOCK: i32 = 48;
+const BLOCK: i32 = 48;
 /// Spacing of the far-field grid, pixels.
 const GRID: i32 = 4;
 /// Pixel offsets within a grid cell, as fractions of it.
@@ -52,7 +52,7 @@ pub(super) struct Setup<'a> {
     pub window: RectI,
     pub scale: PixelScale,
     /// Destination segments in this window's pixel space (centres at k + 0.5).
-    pub segments: Vec<(Vec2, Vec2)>,
+    segments: Vec<(Vec2, Vec2)>,
     /// What the check points must meet per axis (pixels); `None` evaluates
     /// every block exactly.
     tol: Option<[f32; 2]>,
@@ -88,6 +88,12 @@ impl<'a> Setup<'a> {
 
     fn blocks_across(&self) -> usize {
         self.window.width().div_ceil(BLOCK as usize)
+    }
+
+    /// The columns of block `k` of a band, as offsets from the window's left.
+    pub fn block_columns(&self, k: usize) -> std::ops::Range<usize> {
+        let x1 = k * BLOCK as usize;
+        x1..(x1 + BLOCK as usize).min(self.window.width())
     }
 
     /// Blocks in the window, numbered row of blocks by row from the bottom.
@@ -156,35 +162,43 @@ pub(super) struct Band<'a> {
 impl Band<'_> {
     /// Block `k` of the band, from the left.
     pub fn block(&mut self, k: usize) -> Block<'_> {
-        let window = self.setup.window;
-        let x1 = window.x1 + k as i32 * BLOCK;
+        let (x1, cols) = (self.setup.window.x1, self.setup.block_columns(k));
         Block {
             setup: self.setup,
-            rect: RectI::new(x1, self.y1, (x1 + BLOCK).min(window.x2), self.y2),
+            rect: RectI::new(
+                x1 + cols.start as i32,
+                self.y1,
+                x1 + cols.end as i32,
+                self.y2,
+            ),
             out: &mut *self.out,
             weights: self.weights.as_deref_mut(),
             scratch: &mut self.scratch,
         }
     }
 
-    /// Pixels `x1..x2` of row `j`: positions and `Σ w` (when kept).
-    pub fn row_mut(&mut self, j: i32, x1: i32, x2: i32) -> (&mut [[f32; 2]], Option<&mut [f32]>) {
-        let window = self.setup.window;
-        let start = (j - self.y1) as usize * window.width() + (x1 - window.x1) as usize;
-        let n = (x2 - x1) as usize;
-        let weights = self
-            .weights
-            .as_deref_mut()
-            .map(|w| &mut w[start..start + n]);
-        (&mut self.out[start..start + n], weights)
+    /// Row `j` across the window: positions and `Σ w` (when kept).
+    pub fn row_mut(&mut self, j: i32) -> (&mut [[f32; 2]], Option<&mut [f32]>) {
+        let w = self.setup.window.width();
+        let start = (j - self.y1) as usize * w;
+        row_slices(self.out, self.weights.as_deref_mut(), start..start + w)
     }
+}
+
+/// The pixels `at` of a band's positions and, when kept, `Σ w`.
+fn row_slices<'a>(
+    out: &'a mut [[f32; 2]],
+    weights: Option<&'a mut [f32]>,
+    at: std::ops::Range<usize>,
+) -> (&'a mut [[f32; 2]], Option<&'a mut [f32]>) {
+    (&mut out[at.clone()], weights.map(|w| &mut w[at]))
 }
 
 /// One block of the map being made.
 pub(super) struct Block<'a> {
-    pub setup: &'a Setup<'a>,
+    setup: &'a Setup<'a>,
     /// The block's pixels.
-    pub rect: RectI,
+    rect: RectI,
     /// The band of the map this block lies in (rows from the block's `y1`).
     out: &'a mut [[f32; 2]],
     /// The same band of `Σ w` per pixel, when kept.
@@ -287,12 +301,9 @@ impl Block<'_> {
 
     /// Row `j`'s positions and, when kept, its `Σ w`.
     fn rows_mut(&mut self, j: i32) -> (&mut [[f32; 2]], Option<&mut [f32]>) {
-        let (start, n) = (self.row_start(j), self.rect.width());
-        let weights = self
-            .weights
-            .as_deref_mut()
-            .map(|w| &mut w[start..start + n]);
-        (&mut self.out[start..start + n], weights)
+        let start = self.row_start(j);
+        let at = start..start + self.rect.width();
+        row_slices(self.out, self.weights.as_deref_mut(), at)
     }
 
     /// Every pixel of the block with all lines.
@@ -322,20 +333,14 @@ impl Block<'_> {
         }
     }
 
-    /// The centres' x of the block's pixels along a row, into `scratch.xs`.
-    fn row_xs(&mut self) {
-        let (b, scale) = (self.rect, self.setup.scale);
-        self.scratch.xs.clear();
-        (self.scratch.xs).extend((b.x1..b.x2).map(|i| scale.pixel_centre(i, b.y1).x as f32));
-    }
-
     /// Each row of the block through `lines`, plus the far field from `grid`
     /// when there is one.
     fn rows(&mut self, lines: &Lines, grid: Option<&Grid>) {
         let b = self.rect;
         let n = b.width();
-        self.row_xs();
         let mut sc = std::mem::take(self.scratch);
+        sc.xs.clear();
+        sc.xs.extend((b.x1..b.x2).map(|i| self.centre(i, b.y1).0));
         for v in [&mut sc.ys, &mut sc.ox, &mut sc.oy, &mut sc.ow] {
             v.resize(n, 0.0);
         }
