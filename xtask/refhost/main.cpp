@@ -137,7 +137,9 @@ struct Render {
 
 /// One frame as a host renders it: region of definition, identity,
 /// begin, regions of interest, render, end. Then the output is read back.
-Render render(Effect &fx, OfxPointD scale, const Where &w) {
+/// `interactive`: a viewer's render while the instance is manipulated
+/// (not sequential); otherwise one frame of a sequential render.
+Render render(Effect &fx, OfxPointD scale, const Where &w, bool interactive = false) {
   Render out;
   const OfxTime t = 0;
   fx.renderScale = scale;
@@ -159,16 +161,16 @@ Render render(Effect &fx, OfxPointD scale, const Where &w) {
     return out;
   }
   expectOk(s, w, "isIdentity");
-  expectOk(fx.beginRenderAction(t, t, 1, false, scale, true, false), w,
+  expectOk(fx.beginRenderAction(t, t, 1, interactive, scale, !interactive, interactive), w,
            "beginSequenceRender");
   fx.regionsOfInterest.clear();
   expectOk(fx.getRegionOfInterestAction(t, scale, rod, fx.regionsOfInterest), w,
            "getRegionsOfInterest");
   fx.persistentError.clear();
   fx.rendering = true;
-  s = fx.renderAction(t, kOfxImageFieldNone, win, scale, true, false, false);
+  s = fx.renderAction(t, kOfxImageFieldNone, win, scale, !interactive, interactive, false);
   fx.rendering = false;
-  expectOk(fx.endRenderAction(t, t, 1, false, scale, true, false), w,
+  expectOk(fx.endRenderAction(t, t, 1, interactive, scale, !interactive, interactive), w,
            "endSequenceRender");
   if (s != kOfxStatOK) {
     fail(w.text + ": render returned " + statusName(s) + " (" +
@@ -303,6 +305,54 @@ void checkIdentity(Effect &fx, const std::string &context, const Where &w) {
 int choiceCount(IE::Instance &fx, const std::string &name) {
   auto *p = fx.getParam(name);
   return p ? p->getProperties().getDimension(kOfxParamPropChoiceOption) : 0;
+}
+
+/// A viewer dragging one of ten lines (`field` method), as the library
+/// sends it (`kOfxImageEffectPropInteractiveRenderStatus` 1, not
+/// sequential): interactive renders after each move, where the plugin may
+/// redo its maps from the last ones, end at the picture a sequential
+/// render of the same lines makes afresh. In this 96 × 64 frame every block
+/// lies within the moved line's reach, so the redo remakes each block and
+/// the two agree exactly; the swap of far blocks is held by the harness's
+/// `tests/drag.rs` at 320 × 180.
+void checkDrag(Effect &fx, const Where &w) {
+  auto *text = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_text"));
+  auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("method"));
+  if (!text || !method) return fail(w.text + ": no scene_text or method param");
+  for (int m = 0; m < choiceCount(fx, "method"); ++m)
+    if (method->getProperties().getStringProperty(kOfxParamPropChoiceOption, m) == "field")
+      method->set(m);
+  const auto scene = [](double dx) {
+    std::ostringstream s;
+    s << "{\"format\": \"morphfx-scene\", \"version\": 1, \"features\": [";
+    for (int k = 0; k < 8; ++k) {
+      const double x = 8 + 11 * k, y = 10 + 6 * k;
+      s << (k ? ", " : "") << "{\"type\": \"line\", \"a\": [[" << x + (k ? 0 : dx) << ", "
+        << y << "], [" << x + 6 << ", " << y + 14 << "]], \"b\": [[" << x + 2 << ", " << y - 1
+        << "], [" << x + 7 << ", " << y + 15 << "]]}";
+    }
+    s << "]}";
+    return s.str();
+  };
+  const OfxPointD one = {1, 1};
+  std::vector<float> viewer;
+  for (int step = 0; step < 4; ++step) {
+    text->set(scene(1.5 * step).c_str());
+    if (!render(fx, one, w.with("interactive, move " + std::to_string(step)), true).ok) return;
+    viewer = outputPixels(fx);
+  }
+  if (!render(fx, one, w.with("sequential")).ok) return;
+  const std::vector<float> fresh = outputPixels(fx);
+  if (fresh.size() != viewer.size()) return fail(w.text + ": renders of different sizes");
+  float worst = 0;
+  for (size_t k = 0; k < fresh.size(); ++k) worst = std::max(worst, std::fabs(fresh[k] - viewer[k]));
+  if (worst > 0.01f) {
+    std::ostringstream m;
+    m << w.text << ": the interactive render after the drag differs by " << worst
+      << " from a sequential render of the same lines";
+    fail(m.str());
+  }
+  std::cout << "refhost: " << w.text << ": largest difference " << worst << std::endl;
 }
 
 /// The overlay as the library's own interact classes drive it.
@@ -624,6 +674,8 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
     loadScene(*fx, w);
     if (inputClips(*fx).size() == 2) checkTrack(*fx, w.with("track"));
     checkMattes(*fx, w.with("mattes"));
+    checkDrag(*fx, w.with("drag"));
+    loadScene(*fx, w);
   }
 
   auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("method"));
