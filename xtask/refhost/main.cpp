@@ -345,7 +345,8 @@ void checkDrag(Effect &fx, const Where &w) {
   const std::vector<float> fresh = outputPixels(fx);
   if (fresh.size() != viewer.size()) return fail(w.text + ": renders of different sizes");
   float worst = 0;
-  for (size_t k = 0; k < fresh.size(); ++k) worst = std::max(worst, std::fabs(fresh[k] - viewer[k]));
+  for (size_t k = 0; k < fresh.size(); ++k)
+    worst = std::max(worst, std::fabs(fresh[k] - viewer[k]));
   if (worst > 0.01f) {
     std::ostringstream m;
     m << w.text << ": the interactive render after the drag differs by " << worst
