@@ -6,14 +6,22 @@
 //! row through the view and checks slices per tap; here each tap pair is
 //! addressed from the buffer's origin and stride, so a pixel is a few integer
 //! operations and two eight-wide loads (bilinear), or eight (bicubic: each
-//! row's four taps are two loads, weighted by pairs of columns at once). The dissolve samples both sources of a
-//! pixel in the same iteration ([`blend_row`]): four independent loads close
-//! together keep more of them in flight, and no second row is written and read
-//! back. Bilinear values are bit for bit those of the general path for other
+//! row's four taps are two loads, weighted by pairs of columns at once).
+//! With FMA, bilinear pixels go two at a time, their horizontal steps in one
+//! vector. The dissolve samples both sources of a pixel in the same
+//! iteration ([`blend_row`]): four independent loads close together keep
+//! more of them in flight, and no second row is written and read back.
+//!
+//! What bounds this kernel is memory latency more than arithmetic: a warp
+//! walks each output row across many source rows, so the taps of pixels a
+//! little ahead are asked of the cache early ([`Taps::prefetch`]).
+//!
+//! Bilinear values are bit for bit those of the general path for other
 //! sample types and of the separate blend (the same fused multiply-adds in
 //! the same order); bicubic ones sum the same sixteen products in another
-//! order (within a few float ulps). Positions it does not take (taps outside the image, on or near a
-//! pixel centre, NaN) go to the caller's one-pixel fallback.
+//! order (within a few float ulps). Positions it does not take (taps
+//! outside the image, on or near a pixel centre, NaN) go to the caller's
+//! one-pixel fallback.
 
 use wide::{f32x8, i32x8};
 
@@ -25,6 +33,30 @@ use crate::geom::{PixelScale, RectI};
 /// The general sampler snaps by the same bound, and positions this kernel
 /// leaves to it are those it would snap.
 pub(crate) const SNAP: f32 = 1e-4;
+
+/// How many groups of four pixels ahead [`Taps::prefetch`] asks for taps:
+/// 32 pixels, a few hundred nanoseconds at this kernel's pace, about one
+/// memory latency. Measured against 4, 12 and 16 (no better) in
+/// docs/PERFORMANCE.md.
+const AHEAD: usize = 8;
+
+/// `Located::fast` when all four pixels take the direct path on both axes.
+const ALL_FAST: u32 = 0xff;
+
+/// Whether bilinear pixels go two at a time ([`Taps::pixel_pair`]): only
+/// where eight-wide `mul_add` is the fused operation scalar `f32::mul_add`
+/// is, so both give the same bits.
+const PAIRS: bool = cfg!(target_feature = "fma");
+
+/// Asks the cache for the line holding `v`: a hint only, and none on
+/// targets without a prefetch we can issue without `unsafe`.
+#[inline(always)]
+fn prefetch<T>(v: &T) {
+    #[cfg(target_arch = "x86_64")]
+    safe_arch::prefetch_t0(v);
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = v;
+}
 
 /// A source sampled by direct addressing; see [`Taps::new`].
 #[derive(Clone, Copy)]
@@ -110,6 +142,40 @@ impl<'a, T: Sample> Taps<'a, T> {
         }
     }
 
+    /// Asks the cache for the top row of taps of pixels 0 and 2 of four
+    /// positions, [`AHEAD`] groups before their turn.
+    ///
+    /// Rows go up the output, so the top row is the one no earlier output
+    /// row brought in. A warp's taps wander across source rows along an
+    /// output row (a 100-line field warp's cross ~30 of them), which the
+    /// hardware's stream prefetchers never lock onto: without this, each
+    /// new cache line is a full memory latency with few others in flight.
+    #[inline(always)]
+    fn prefetch(&self, positions: &[f32; 8]) {
+        let f = f32x8::new(*positions) * self.scale - f32x8::splat(0.5);
+        let offsets = ((f.floor() - self.lo).fast_trunc_int() * self.step).to_array();
+        let top = if self.cubic { 3 } else { 1 } * self.stride;
+        for k in [0, 2] {
+            // Wrapping: NaN positions give nonsense indices, which `get`
+            // turns away (or which point at a harmless line).
+            let at = (self.base.wrapping_add(offsets[2 * k]))
+                .wrapping_add(offsets[2 * k + 1])
+                .wrapping_add(top);
+            if let Some(v) = self.data.get(at as u32 as usize) {
+                prefetch(v);
+            }
+        }
+    }
+
+    /// The eight samples from index `at`: two pixels of a tap row.
+    #[inline(always)]
+    fn load(&self, at: i32) -> f32x8 {
+        // Indices inside the buffer, which fits `i32`; through `u32` the
+        // slice end cannot overflow, so one check per load remains.
+        let at = at as u32 as usize;
+        T::load8(&self.data[at..at + 8])
+    }
+
     /// Pixel `k` of a located four, both axes on the fast path.
     #[inline(always)]
     fn pixel(&self, l: &Located, k: usize) -> [f32; 4] {
@@ -133,6 +199,26 @@ impl<'a, T: Sample> Taps<'a, T> {
         let tx = l.t[x];
         std::array::from_fn(|c| (v[4 + c] - v[c]).mul_add(tx, v[c]))
     }
+
+    /// Bilinear pixels `k` and `k + 1` of a located four, all four taps on
+    /// the fast path: the same operations as two [`Self::pixel`]s, the
+    /// horizontal step for both pixels in one eight-wide vector.
+    #[inline(always)]
+    fn pixel_pair(&self, l: &Located, k: usize) -> f32x8 {
+        let vertical = |k: usize| {
+            let at = self.base + l.offsets[2 * k] + l.offsets[2 * k + 1];
+            let (below, above) = (self.load(at), self.load(at + self.stride));
+            (above - below)
+                .mul_add(f32x8::splat(l.t[2 * k + 1]), below)
+                .to_array()
+        };
+        let (p, q) = (vertical(k), vertical(k + 1));
+        let left = f32x8::new([p[0], p[1], p[2], p[3], q[0], q[1], q[2], q[3]]);
+        let right = f32x8::new([p[4], p[5], p[6], p[7], q[4], q[5], q[6], q[7]]);
+        let (tp, tq) = (l.t[2 * k], l.t[2 * k + 2]);
+        let t = f32x8::new([tp, tp, tp, tp, tq, tq, tq, tq]);
+        (right - left).mul_add(t, left)
+    }
 }
 
 impl<T: Sample> Taps<'_, T> {
@@ -144,10 +230,7 @@ impl<T: Sample> Taps<'_, T> {
     fn cubic_pixel(&self, l: &Located, k: usize) -> [f32; 4] {
         let (x, y) = (2 * k, 2 * k + 1);
         let at = self.base + l.offsets[x] + l.offsets[y];
-        let load = |at: i32| {
-            let at = at as u32 as usize;
-            T::load8(&self.data[at..at + 8])
-        };
+        let load = |at: i32| self.load(at);
         let wx = super::kernel::catmull_rom_weights(l.t[x]);
         let wy = super::kernel::catmull_rom_weights(l.t[y]);
         let pair = |a: f32, b: f32| f32x8::new([a, a, a, a, b, b, b, b]);
@@ -179,7 +262,18 @@ pub(crate) fn row<T: Sample>(
     assert_eq!(positions.len(), out.len(), "one position per pixel");
     let four = groups(positions);
     for (g, (p, outs)) in four.iter().zip(out.chunks_exact_mut(4)).enumerate() {
+        if let Some(ahead) = four.get(g + AHEAD) {
+            taps.prefetch(ahead);
+        }
         let l = taps.locate(p);
+        if PAIRS && l.fast == ALL_FAST && !taps.cubic {
+            for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
+                *o.as_flattened_mut()
+                    .first_chunk_mut::<8>()
+                    .expect("two pixels") = taps.pixel_pair(&l, k).to_array();
+            }
+            continue;
+        }
         for (k, o) in outs.iter_mut().enumerate() {
             if (l.fast >> (2 * k)) & 3 == 3 {
                 *o = taps.pixel(&l, k);
@@ -209,7 +303,23 @@ pub(crate) fn blend_row<S: Sample>(
     let (four_a, four_b) = (groups(pa), groups(pb));
     let pixels = out.chunks_exact_mut(4);
     for (g, ((qa, qb), outs)) in four_a.iter().zip(four_b).zip(pixels).enumerate() {
+        if let (Some(qa), Some(qb)) = (four_a.get(g + AHEAD), four_b.get(g + AHEAD)) {
+            a.prefetch(qa);
+            b.prefetch(qb);
+        }
         let (la, lb) = (a.locate(qa), b.locate(qb));
+        if PAIRS && la.fast & lb.fast == ALL_FAST && !a.cubic && !b.cubic {
+            let (wa8, wb8) = (f32x8::splat(wa), f32x8::splat(wb));
+            for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
+                let v = b
+                    .pixel_pair(&lb, k)
+                    .mul_add(wb8, a.pixel_pair(&la, k) * wa8);
+                *o.as_flattened_mut()
+                    .first_chunk_mut::<8>()
+                    .expect("two pixels") = v.to_array();
+            }
+            continue;
+        }
         for (k, o) in outs.iter_mut().enumerate() {
             let (fast_a, fast_b) = ((la.fast >> (2 * k)) & 3 == 3, (lb.fast >> (2 * k)) & 3 == 3);
             *o = if fast_a && fast_b {

@@ -38,15 +38,9 @@ fn morphfx(release: bool, bundle: &Path) -> Command {
 }
 
 fn cargo(args: &[&str]) {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .args(args)
-        .current_dir(root())
-        .status()
-        .expect("cargo runs");
-    if !status.success() {
-        exit(status.code().unwrap_or(1));
-    }
+    let mut c = cargo_command();
+    c.args(args);
+    run_cargo(c);
 }
 
 fn target_dir() -> PathBuf {
@@ -56,30 +50,69 @@ fn target_dir() -> PathBuf {
 }
 
 /// `cargo build --package morphfx-ofx`, for baseline x86-64 or, with
-/// `fast`, for x86-64-v3 in its own target folder (other RUSTFLAGS would
-/// otherwise rebuild the baseline's artefacts each time). Returns the `.so`.
+/// `fast`, for x86-64-v3 in its own target folder. Returns the `.so`.
 fn build_plugin(release: bool, fast: bool) -> PathBuf {
     let profile = if release { "release" } else { "debug" };
-    let cargo_bin = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut c = Command::new(cargo_bin);
-    c.args(["build", "--package", "morphfx-ofx"])
-        .current_dir(root());
+    let (mut c, dir) = if fast {
+        fast_cargo()
+    } else {
+        (cargo_command(), target_dir())
+    };
+    c.args(["build", "--package", "morphfx-ofx"]);
     if release {
         c.arg("--release");
     }
-    let mut dir = target_dir();
-    if fast {
-        dir = dir.join("x86-64-v3");
-        let flags = std::env::var("RUSTFLAGS").unwrap_or_default();
-        c.env("RUSTFLAGS", format!("{flags} -C target-cpu=x86-64-v3"))
-            .arg("--target-dir")
-            .arg(&dir);
-    }
+    run_cargo(c);
+    dir.join(profile).join("libmorphfx_ofx.so")
+}
+
+fn cargo_command() -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(root());
+    c
+}
+
+/// Cargo building x86-64-v3 code (AVX2, FMA) in its own target folder
+/// (other RUSTFLAGS would otherwise rebuild the baseline's artefacts each
+/// time), and that folder.
+fn fast_cargo() -> (Command, PathBuf) {
+    let dir = target_dir().join("x86-64-v3");
+    let flags = std::env::var("RUSTFLAGS").unwrap_or_default();
+    let mut c = cargo_command();
+    c.env("RUSTFLAGS", format!("{flags} -C target-cpu=x86-64-v3"))
+        .arg("--target-dir")
+        .arg(&dir);
+    (c, dir)
+}
+
+fn run_cargo(mut c: Command) {
     let status = c.status().expect("cargo runs");
     if !status.success() {
         exit(status.code().unwrap_or(1));
     }
-    dir.join(profile).join("libmorphfx_ofx.so")
+}
+
+/// The core's unit tests again as x86-64-v3 code, which is what the
+/// bundle's fast build runs: with FMA the resampling kernels take paths
+/// (two bilinear pixels per vector) that baseline code leaves out, and
+/// their bit-exactness tests must see them. Skipped on a CPU without AVX2
+/// and FMA, which could not run that code.
+fn core_tests_fast() {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        let (mut c, _) = fast_cargo();
+        c.args([
+            "test",
+            "--package",
+            "morphfx",
+            "--lib",
+            "--features",
+            "testing",
+        ]);
+        run_cargo(c);
+        return;
+    }
+    println!("core tests as x86-64-v3 code: skipped, this CPU lacks AVX2 or FMA");
 }
 
 /// The OFX architecture folders a build for this machine goes into. The
@@ -157,6 +190,7 @@ fn main() {
             let mut run = vec!["test", "--workspace"];
             run.extend(args[1..].iter().map(String::as_str));
             cargo(&run);
+            core_tests_fast();
             release_concurrency(&b);
             docs();
             refhost::check(&b);
