@@ -6,7 +6,8 @@
 //! row through the view and checks slices per tap; here each tap pair is
 //! addressed from the buffer's origin and stride, so a pixel is a few integer
 //! operations and two eight-wide loads (bilinear), or eight (bicubic: each
-//! row's four taps are two loads, weighted by pairs of columns at once).
+//! row's four taps are two loads, summed down the rows, then weighted by
+//! pairs of columns at once).
 //! With FMA, bilinear pixels go two at a time, their horizontal steps in one
 //! vector. The dissolve samples both sources of a pixel in the same
 //! iteration ([`blend_row`]): four independent loads close together keep
@@ -89,6 +90,9 @@ struct Located {
     offsets: [i32; 8],
     /// Fractions (weights of the right and upper taps), interleaved.
     t: [f32; 8],
+    /// Bicubic only: the Catmull-Rom weights of taps −1, 0, 1, 2 for each
+    /// fraction, computed for all eight at once.
+    w: [[f32; 8]; 4],
 }
 
 impl<'a, T: Sample> Taps<'a, T> {
@@ -139,6 +143,10 @@ impl<'a, T: Sample> Taps<'a, T> {
             // part for bicubic (whose `lo` is one above the corner).
             offsets: ((whole - self.lo).fast_trunc_int() * self.step).to_array(),
             t: t.to_array(),
+            w: match self.cubic {
+                true => super::kernel::catmull_rom_weights8(t).map(f32x8::to_array),
+                false => [[0.0; 8]; 4],
+            },
         }
     }
 
@@ -223,24 +231,28 @@ impl<'a, T: Sample> Taps<'a, T> {
 
 impl<T: Sample> Taps<'_, T> {
     /// Pixel `k` of a located four by Catmull-Rom: each of the four rows'
-    /// four taps (sixteen floats) is two eight-wide loads, weighted two
-    /// columns at a time, and the rows summed by their weights; the two
-    /// halves of the sum then add up to the pixel.
+    /// four taps (sixteen floats) is two eight-wide loads; the columns are
+    /// summed down the rows by the rows' weights first (two independent
+    /// chains), then weighted two columns at a time, and the two halves of
+    /// the sum add up to the pixel. The weights come with the location,
+    /// computed for four pixels at once.
     #[inline(always)]
     fn cubic_pixel(&self, l: &Located, k: usize) -> [f32; 4] {
         let (x, y) = (2 * k, 2 * k + 1);
         let at = self.base + l.offsets[x] + l.offsets[y];
         let load = |at: i32| self.load(at);
-        let wx = super::kernel::catmull_rom_weights(l.t[x]);
-        let wy = super::kernel::catmull_rom_weights(l.t[y]);
+        let w = &l.w;
         let pair = |a: f32, b: f32| f32x8::new([a, a, a, a, b, b, b, b]);
-        let (left, right) = (pair(wx[0], wx[1]), pair(wx[2], wx[3]));
-        let mut sum = f32x8::ZERO;
-        for (r, w) in wy.iter().enumerate() {
-            let row = at + r as i32 * self.stride;
-            let h = load(row + 8).mul_add(right, load(row) * left);
-            sum = h.mul_add(f32x8::splat(*w), sum);
+        let (left, right) = (pair(w[0][x], w[1][x]), pair(w[2][x], w[3][x]));
+        // Columns −1, 0 (`near`) and 1, 2 (`far`) summed down the rows first.
+        let row = |r: i32| at + r * self.stride;
+        let wy = |r: usize| f32x8::splat(w[r][y]);
+        let (mut near, mut far) = (load(row(0)) * wy(0), load(row(0) + 8) * wy(0));
+        for r in 1..4 {
+            near = load(row(r as i32)).mul_add(wy(r), near);
+            far = load(row(r as i32) + 8).mul_add(wy(r), far);
         }
+        let sum = far.mul_add(right, near * left);
         let v = sum.to_array();
         std::array::from_fn(|c| v[c] + v[4 + c])
     }
