@@ -5,6 +5,8 @@
 //! `S_to(s, r) = p`, and sampled at `S_from(s, r)`. Row neighbours start from
 //! each other's solution, so most pixels converge in one or two steps.
 
+mod lanes;
+
 use rayon::prelude::*;
 
 use super::{Mesh, MeshPair};
@@ -21,9 +23,15 @@ const M: [[f64; 4]; 4] = [
     [-1.0, 3.0, -3.0, 1.0],
 ];
 
+/// Rows of the map computed together, one per lane of `f64x4` ([`lanes`]).
+const LANES: usize = 4;
+
 /// Newton stops when the located point is this close (canonical pixels).
 const TOLERANCE: f64 = 1e-7;
 const MAX_STEPS: usize = 16;
+/// Newton also stops after a step shorter than this (cells); see
+/// [`Surface::solve`].
+const EARLY_EXIT: f64 = 1e-4;
 
 /// Surface parameters `(s, r)`: column and row index, fractional.
 type Params = (f64, f64);
@@ -117,11 +125,19 @@ impl Surface {
         }
     }
 
+    /// The cell (column, row) whose patch evaluates `(s, r)`: the one
+    /// holding it, or the nearest border cell for parameters outside.
+    #[inline]
+    fn cell(&self, s: f64, r: f64) -> (usize, usize) {
+        let c = (s.floor() as isize).clamp(0, self.cols as isize - 2) as usize;
+        let k = (r.floor() as isize).clamp(0, self.rows as isize - 2) as usize;
+        (c, k)
+    }
+
     /// `S(s, r)` and its partial derivatives.
     #[inline]
     fn eval(&self, s: f64, r: f64) -> (Vec2, Vec2, Vec2) {
-        let c = (s.floor() as isize).clamp(0, self.cols as isize - 2) as usize;
-        let k = (r.floor() as isize).clamp(0, self.rows as isize - 2) as usize;
+        let (c, k) = self.cell(s, r);
         let (u, v) = (s - c as f64, r - k as f64);
         let cell = &self.coef[k * (self.cols - 1) + c];
         let pu = [1.0, u, u * u, u * u * u];
@@ -149,8 +165,7 @@ impl Surface {
     /// `S(s, r)` alone (no derivatives): where a located point samples.
     #[inline]
     fn position(&self, s: f64, r: f64) -> Vec2 {
-        let c = (s.floor() as isize).clamp(0, self.cols as isize - 2) as usize;
-        let k = (r.floor() as isize).clamp(0, self.rows as isize - 2) as usize;
+        let (c, k) = self.cell(s, r);
         let (u, v) = (s - c as f64, r - k as f64);
         let cell = &self.coef[k * (self.cols - 1) + c];
         let pu = [1.0, u, u * u, u * u * u];
@@ -202,7 +217,7 @@ impl Surface {
             // slope per cell), so after one this small the point lies within
             // ~1e-6 px on a 100 px cell, under the f32 map's rounding: no
             // need to evaluate again.
-            if m < 1e-4 {
+            if m < EARLY_EXIT {
                 return Some((s, r));
             }
         }
@@ -281,6 +296,51 @@ impl MeshWarp {
     }
 }
 
+/// Each pixel starts Newton where the last two solutions of its row point:
+/// one step usually lands within tolerance.
+fn extrapolate(prev: Option<Params>, before: Option<Params>) -> Option<Params> {
+    match (prev, before) {
+        (Some(a), Some(b)) => Some((2.0 * a.0 - b.0, 2.0 * a.1 - b.1)),
+        _ => prev,
+    }
+}
+
+/// A row's last two solutions, the pixel just mapped's first; a pixel off
+/// the mesh forgets both.
+#[derive(Clone, Copy, Default)]
+struct Trail {
+    prev: Option<Params>,
+    before: Option<Params>,
+}
+
+impl Trail {
+    fn guess(&self) -> Option<Params> {
+        extrapolate(self.prev, self.before)
+    }
+
+    fn push(&mut self, found: Option<Params>) {
+        *self = match found {
+            Some(_) => Trail {
+                prev: found,
+                before: self.prev,
+            },
+            None => Trail::default(),
+        };
+    }
+}
+
+impl MeshWarp {
+    /// Row `j` of the map, pixels `x1..`, into `out`.
+    fn map_row(&self, x1: i32, j: i32, scale: PixelScale, out: &mut [[f32; 2]]) {
+        let mut trail = Trail::default();
+        for (k, o) in out.iter_mut().enumerate() {
+            let (q, g) = self.locate(scale.pixel_centre(x1 + k as i32, j), trail.guess());
+            trail.push(g);
+            *o = [q.x as f32, q.y as f32];
+        }
+    }
+}
+
 impl Warp for MeshWarp {
     fn map(&self, p: Vec2) -> Vec2 {
         if self.identity {
@@ -309,25 +369,18 @@ impl Warp for MeshWarp {
         let w = window.width();
         let mut pos = vec![[0f32; 2]; window.area()];
         if w > 0 {
-            pos.par_chunks_mut(w).enumerate().for_each(|(row, out)| {
-                let j = window.y1 + row as i32;
-                // Start each pixel where the last two solutions point: one
-                // Newton step usually lands within tolerance.
-                let (mut prev, mut before): (Option<Params>, Option<Params>) = (None, None);
-                for (k, o) in out.iter_mut().enumerate() {
-                    let guess = match (prev, before) {
-                        (Some(a), Some(b)) => Some((2.0 * a.0 - b.0, 2.0 * a.1 - b.1)),
-                        _ => prev,
-                    };
-                    let (q, g) = self.locate(scale.pixel_centre(window.x1 + k as i32, j), guess);
-                    if g.is_some() {
-                        (before, prev) = (prev, g);
+            pos.par_chunks_mut(LANES * w)
+                .enumerate()
+                .for_each(|(band, out)| {
+                    let j = window.y1 + (LANES * band) as i32;
+                    if out.len() == LANES * w {
+                        self.map_rows4(window.x1, j, scale, out);
                     } else {
-                        (before, prev) = (None, None);
+                        for (row, out) in out.chunks_mut(w).enumerate() {
+                            self.map_row(window.x1, j + row as i32, scale, out);
+                        }
                     }
-                    *o = [q.x as f32, q.y as f32];
-                }
-            });
+                });
         }
         WarpMap::new(window, scale, pos)
     }
@@ -354,17 +407,81 @@ mod tests {
         None
     }
 
-    #[test]
-    fn the_dense_map_matches_a_strict_solve_on_a_curved_mesh() {
-        let (w, h) = (240.0, 160.0);
-        let src = Mesh::regular(7, 9, 0.0, 0.0, w, h).unwrap();
+    /// A 240 × 160 mesh pair whose interior bends by up to 9 px.
+    fn curved() -> MeshWarp {
+        let src = Mesh::regular(7, 9, 0.0, 0.0, 240.0, 160.0).unwrap();
         let dst = src.map_nodes(|r, c, p| {
             if r == 0 || c == 0 || r == 6 || c == 8 {
                 return p;
             }
             p + Vec2::new(9.0 * (p.y * 0.05).sin(), 7.0 * (p.x * 0.04).cos())
         });
-        let warp = MeshWarp::new(&src, &dst);
+        MeshWarp::new(&src, &dst)
+    }
+
+    #[test]
+    fn four_rows_at_once_give_the_one_row_paths_bits() {
+        let warp = curved();
+        // Past the mesh on every side, and a height no multiple of four.
+        let window = RectI::new(-12, -7, 251, 170);
+        let map = warp.map_window(window, PixelScale::UNIT);
+        let w = window.width();
+        for j in window.y1..window.y2 {
+            let mut row = vec![[0f32; 2]; w];
+            warp.map_row(window.x1, j, PixelScale::UNIT, &mut row);
+            let got = map.row(j).unwrap();
+            for (i, (a, b)) in got.iter().zip(&row).enumerate() {
+                assert_eq!(
+                    a.map(f32::to_bits),
+                    b.map(f32::to_bits),
+                    "pixel ({}, {j})",
+                    window.x1 + i as i32
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_lanes_settle_nearly_every_pixel_of_a_curved_mesh() {
+        let warp = curved();
+        // Bands of four rows as the map goes, guesses from the one-row path:
+        // on this mesh most pixels take two Newton steps.
+        let (mut lanes, mut settled) = (0, 0);
+        for j in (4..150).step_by(4) {
+            let mut trails = [Trail::default(); LANES];
+            for i in 4..236 {
+                let p: [Vec2; LANES] =
+                    std::array::from_fn(|l| PixelScale::UNIT.pixel_centre(i, j + l as i32));
+                let guesses = trails.map(|t| t.guess());
+                if guesses.iter().all(Option::is_some) {
+                    let g = guesses.map(Option::unwrap);
+                    let s = wide::f64x4::new(g.map(|g| g.0));
+                    let r = wide::f64x4::new(g.map(|g| g.1));
+                    let at = lanes::Lanes {
+                        s,
+                        r,
+                        found: 0b1111,
+                    };
+                    let found = warp.to.solve4(lanes::Points::new(p), at);
+                    lanes += LANES;
+                    settled += found.found.count_ones() as usize;
+                }
+                for (l, t) in trails.iter_mut().enumerate() {
+                    t.push(warp.locate(p[l], t.guess()).1);
+                }
+            }
+        }
+        assert!(lanes > 25_000, "{lanes} lanes tried");
+        assert!(
+            settled * 100 > lanes * 95,
+            "{settled} of {lanes} lanes settled"
+        );
+    }
+
+    #[test]
+    fn the_dense_map_matches_a_strict_solve_on_a_curved_mesh() {
+        let (w, h) = (240.0, 160.0);
+        let warp = curved();
         let window = RectI::from_size(w as usize, h as usize);
         let map = warp.map_window(window, PixelScale::UNIT);
         let mut worst = 0.0f64;
