@@ -80,8 +80,7 @@ fn fast_cargo() -> (Command, PathBuf) {
     let flags = std::env::var("RUSTFLAGS").unwrap_or_default();
     let mut c = cargo_command();
     c.env("RUSTFLAGS", format!("{flags} -C target-cpu=x86-64-v3"))
-        .arg("--target-dir")
-        .arg(&dir);
+        .env("CARGO_TARGET_DIR", &dir);
     (c, dir)
 }
 
