@@ -50,7 +50,7 @@ const ALL_FAST: u32 = 0xff;
 const PAIRS: bool = cfg!(target_feature = "fma");
 
 /// Asks the cache for the line holding `v`: a hint only, and none on
-/// targets without a prefetch we can issue without `unsafe`.
+/// targets where no safe prefetch wrapper exists.
 #[inline(always)]
 fn prefetch<T>(v: &T) {
     #[cfg(target_arch = "x86_64")]
@@ -129,9 +129,7 @@ impl<'a, T: Sample> Taps<'a, T> {
     #[inline(always)]
     fn locate(&self, positions: &[f32; 8]) -> Located {
         let s = f32x8::splat;
-        // Continuous pixel index: integers are pixel centres.
-        let f = f32x8::new(*positions) * self.scale - s(0.5);
-        let whole = f.floor();
+        let (f, whole) = self.index(positions);
         let t = f - whole;
         // NaN fails every comparison, so it takes the fallback too; so do
         // fractions near a centre line, which the fallback snaps.
@@ -141,13 +139,27 @@ impl<'a, T: Sample> Taps<'a, T> {
             fast: fast.to_bitmask(),
             // Relative to the corner: the first tap, one below the integer
             // part for bicubic (whose `lo` is one above the corner).
-            offsets: ((whole - self.lo).fast_trunc_int() * self.step).to_array(),
+            offsets: self.offsets(whole),
             t: t.to_array(),
             w: match self.cubic {
                 true => super::kernel::catmull_rom_weights8(t).map(f32x8::to_array),
                 false => [[0.0; 8]; 4],
             },
         }
+    }
+
+    /// Four positions' continuous pixel index (integers are pixel centres)
+    /// and its whole part.
+    #[inline(always)]
+    fn index(&self, positions: &[f32; 8]) -> (f32x8, f32x8) {
+        let f = f32x8::new(*positions) * self.scale - f32x8::splat(0.5);
+        (f, f.floor())
+    }
+
+    /// Offsets from `base` of the first taps' columns and rows.
+    #[inline(always)]
+    fn offsets(&self, whole: f32x8) -> [i32; 8] {
+        ((whole - self.lo).fast_trunc_int() * self.step).to_array()
     }
 
     /// Asks the cache for the top row of taps of pixels 0 and 2 of four
@@ -160,8 +172,7 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// new cache line is a full memory latency with few others in flight.
     #[inline(always)]
     fn prefetch(&self, positions: &[f32; 8]) {
-        let f = f32x8::new(*positions) * self.scale - f32x8::splat(0.5);
-        let offsets = ((f.floor() - self.lo).fast_trunc_int() * self.step).to_array();
+        let offsets = self.offsets(self.index(positions).1);
         let top = if self.cubic { 3 } else { 1 } * self.stride;
         for k in [0, 2] {
             // Wrapping: NaN positions give nonsense indices, which `get`
@@ -258,6 +269,14 @@ impl<T: Sample> Taps<'_, T> {
     }
 }
 
+/// Two RGBA pixels from one eight-wide vector.
+#[inline(always)]
+fn put_pair(out: &mut [[f32; 4]; 2], v: f32x8) {
+    *out.as_flattened_mut()
+        .first_chunk_mut::<8>()
+        .expect("two pixels") = v.to_array();
+}
+
 /// The eight floats of each group of four positions.
 fn groups(positions: &[[f32; 2]]) -> &[[f32; 8]] {
     positions.as_flattened().as_chunks::<8>().0
@@ -280,9 +299,7 @@ pub(crate) fn row<T: Sample>(
         let l = taps.locate(p);
         if PAIRS && l.fast == ALL_FAST && !taps.cubic {
             for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
-                *o.as_flattened_mut()
-                    .first_chunk_mut::<8>()
-                    .expect("two pixels") = taps.pixel_pair(&l, k).to_array();
+                put_pair(o, taps.pixel_pair(&l, k));
             }
             continue;
         }
@@ -326,9 +343,7 @@ pub(crate) fn blend_row<S: Sample>(
                 let v = b
                     .pixel_pair(&lb, k)
                     .mul_add(wb8, a.pixel_pair(&la, k) * wa8);
-                *o.as_flattened_mut()
-                    .first_chunk_mut::<8>()
-                    .expect("two pixels") = v.to_array();
+                put_pair(o, v);
             }
             continue;
         }
