@@ -18,7 +18,7 @@ fn morphfx(args: &[&str]) -> (i32, String) {
     )
 }
 
-fn tmp(name: &str) -> PathBuf {
+fn tmp(name: &str) -> common::Scratch {
     common::scratch(name)
 }
 

@@ -2,7 +2,7 @@
 //! at in-between frames, sequence renders against single-frame renders,
 //! EXR precision round trips, and OpenImageIO reading our outputs.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod common;
 use std::process::Command;
@@ -20,7 +20,7 @@ fn morphfx(args: &[&str]) {
     );
 }
 
-fn tmp(name: &str) -> PathBuf {
+fn tmp(name: &str) -> common::Scratch {
     common::scratch(name)
 }
 

@@ -65,13 +65,48 @@ fn newest_in(path: &Path, newest: &mut Option<(std::time::SystemTime, PathBuf)>)
     }
 }
 
-/// An empty folder for one test of this process.
+/// An empty folder for one test of this process, removed when the test
+/// passes. A failing test leaves it, and says where, for a look at what it
+/// wrote; passing runs leave nothing, so a suite run many times over (as CI
+/// and developers do) does not fill the disk with plates.
 #[allow(dead_code)] // not every test file needs one
-pub fn scratch(name: &str) -> PathBuf {
+pub fn scratch(name: &str) -> Scratch {
     let d = std::env::temp_dir().join(format!("morphfx-test-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Scratch(d)
+}
+
+/// The folder [`scratch`] made; a path wherever one is asked for.
+pub struct Scratch(PathBuf);
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("kept for a look: {}", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
 }
 
 /// `morphfx --bundle <the built bundle> ARGS...`, run to completion.
