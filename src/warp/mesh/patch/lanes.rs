@@ -16,8 +16,8 @@ use crate::geom::{PixelScale, Vec2};
 /// Four points, one per lane.
 #[derive(Clone, Copy)]
 pub(super) struct Points {
-    x: f64x4,
-    y: f64x4,
+    pub(super) x: f64x4,
+    pub(super) y: f64x4,
 }
 
 impl Points {
@@ -202,7 +202,7 @@ pub(super) struct Lanes {
 const ALL: u32 = (1 << LANES) - 1;
 
 impl Lanes {
-    fn get(&self, l: usize) -> Option<Params> {
+    pub(super) fn get(&self, l: usize) -> Option<Params> {
         (self.found >> l & 1 == 1).then(|| (self.s.to_array()[l], self.r.to_array()[l]))
     }
 
@@ -225,14 +225,34 @@ impl MeshWarp {
     /// one after another).
     pub(super) fn map_rows4(&self, x1: i32, j: i32, scale: PixelScale, out: &mut [[f32; 2]]) {
         let w = out.len() / LANES;
+        let ys = std::array::from_fn(|l| scale.pixel_centre(0, j + l as i32).y);
+        let xs = (0..w).map(|k| scale.pixel_centre(x1 + k as i32, 0).x);
+        self.rows4(xs, ys, [None; LANES], |k, q, _| {
+            let (qx, qy) = (q.x.to_array(), q.y.to_array());
+            for l in 0..LANES {
+                out[l * w + k] = [qx[l] as f32, qy[l] as f32];
+            }
+        });
+    }
+
+    /// The map at `(x, ys[l])` for each `x` of `xs` in turn, four rows at
+    /// once, each point starting Newton where its row's last two solutions
+    /// point (the first from `seed`): `emit(k, where they map, their
+    /// parameters)` for the `k`th.
+    pub(super) fn rows4(
+        &self,
+        xs: impl Iterator<Item = f64>,
+        ys: [f64; LANES],
+        seed: [Option<Params>; LANES],
+        mut emit: impl FnMut(usize, Points, Lanes),
+    ) {
         // Each row's last two solutions, as the one-row path keeps them.
-        let none = Lanes::from_options([None; LANES]);
-        let (mut prev, mut before) = (none, none);
-        let ys = f64x4::new(std::array::from_fn(|l| {
-            scale.pixel_centre(0, j + l as i32).y
-        }));
-        for k in 0..w {
-            let x = scale.pixel_centre(x1 + k as i32, 0).x;
+        let (mut prev, mut before) = (
+            Lanes::from_options(seed),
+            Lanes::from_options([None; LANES]),
+        );
+        let ys = f64x4::new(ys);
+        for (k, x) in xs.enumerate() {
             let p = Points {
                 x: f64x4::splat(x),
                 y: ys,
@@ -255,10 +275,7 @@ impl MeshWarp {
                 ..prev
             };
             prev = found;
-            let (qx, qy) = (q.x.to_array(), q.y.to_array());
-            for l in 0..LANES {
-                out[l * w + k] = [qx[l] as f32, qy[l] as f32];
-            }
+            emit(k, q, found);
         }
     }
 
