@@ -318,9 +318,15 @@ fn bench_mesh(c: &mut Criterion) {
             ))
         })
     });
-    let warp = MeshWarp::new(&from, &to);
+    // What renders use: the error-checked grid within MeshWarp::TOLERANCE.
+    let warp = MeshWarp::new(&from, &to).within(MeshWarp::TOLERANCE);
     g.bench_function("one_pass_map", |b| {
         b.iter(|| black_box(warp.map_window(frame(), PixelScale::UNIT)))
+    });
+    // Newton at every pixel, the reference the grid is held to.
+    let exact = MeshWarp::new(&from, &to);
+    g.bench_function("one_pass_map_exact", |b| {
+        b.iter(|| black_box(exact.map_window(frame(), PixelScale::UNIT)))
     });
     g.finish();
 }

@@ -5,6 +5,7 @@
 //! `S_to(s, r) = p`, and sampled at `S_from(s, r)`. Row neighbours start from
 //! each other's solution, so most pixels converge in one or two steps.
 
+mod grid;
 mod lanes;
 
 use rayon::prelude::*;
@@ -181,6 +182,14 @@ impl Surface {
         Vec2::new(out[0], out[1])
     }
 
+    /// The shortest side of any cell's node quad (canonical px).
+    fn smallest_cell(&self) -> f64 {
+        self.quads
+            .iter()
+            .flat_map(|q| (0..4).map(move |k| q[k].distance(q[(k + 1) % 4])))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     fn inside_domain(&self, s: f64, r: f64) -> bool {
         let eps = 1e-9;
         s >= -eps
@@ -251,21 +260,43 @@ pub struct MeshWarp {
     to: Surface,
     from: Surface,
     identity: bool,
+    /// How far a dense map may stray from Newton at every pixel (the
+    /// render's px); `None`: not at all.
+    tolerance: Option<f64>,
 }
 
 impl MeshWarp {
-    /// The reverse map from mesh `to` (output) to mesh `from` (source).
+    /// How far the dense maps of renders stray from the exact map at most
+    /// (the render's px): under half the field's default, far under what a
+    /// resampled image shows, and under a seventh of how far the two-pass
+    /// warp differs from the one-pass map.
+    pub const TOLERANCE: f64 = 0.02;
+
+    /// The reverse map from mesh `to` (output) to mesh `from` (source),
+    /// solved at every pixel of a dense map.
     pub fn new(from: &Mesh, to: &Mesh) -> MeshWarp {
         MeshWarp {
             to: Surface::new(to),
             from: Surface::new(from),
             identity: from == to,
+            tolerance: None,
         }
     }
 
-    /// The warp of the image on `side` toward the in-between mesh at `t`.
+    /// This warp with dense maps solved on a coarse grid and interpolated
+    /// where that stays within `tolerance` of the exact map (in the render's
+    /// pixels: a proxy render's map is held to its own coarser pixels).
+    pub fn within(self, tolerance: f64) -> MeshWarp {
+        MeshWarp {
+            tolerance: Some(tolerance),
+            ..self
+        }
+    }
+
+    /// The warp of the image on `side` toward the in-between mesh at `t`,
+    /// dense maps within [`MeshWarp::TOLERANCE`].
     pub fn toward<'a>(pair: &MeshPair, side: Side, t: impl Into<Tween<'a>>) -> MeshWarp {
-        MeshWarp::new(pair.side(side), &pair.tween(t.into()))
+        MeshWarp::new(pair.side(side), &pair.tween(t.into())).within(MeshWarp::TOLERANCE)
     }
 
     /// `p` mapped, starting Newton at `guess`; returns the parameters used so
@@ -368,7 +399,10 @@ impl Warp for MeshWarp {
         }
         let w = window.width();
         let mut pos = vec![[0f32; 2]; window.area()];
-        if w > 0 {
+        let grid = self
+            .tolerance
+            .and_then(|tolerance| self.map_grid(window, scale, tolerance, &mut pos));
+        if grid.is_none() && w > 0 {
             pos.par_chunks_mut(LANES * w)
                 .enumerate()
                 .for_each(|(band, out)| {
@@ -476,6 +510,67 @@ mod tests {
             settled * 100 > lanes * 95,
             "{settled} of {lanes} lanes settled"
         );
+    }
+
+    /// A 240 × 160 mesh pair whose interior swells by up to 4 px, fading
+    /// to nothing at the border: gently enough for a bilinear grid.
+    fn gentle() -> MeshWarp {
+        let src = Mesh::regular(7, 9, 0.0, 0.0, 240.0, 160.0).unwrap();
+        let dst = src.map_nodes(|_, _, p| {
+            use std::f64::consts::PI;
+            let bump = (PI * p.x / 240.0).sin() * (PI * p.y / 160.0).sin();
+            p + Vec2::new(4.0, -3.0) * bump
+        });
+        MeshWarp::new(&src, &dst)
+    }
+
+    #[test]
+    fn the_grid_map_stays_within_its_tolerance_of_the_exact_map() {
+        // Past the mesh on every side, sides no multiple of the grid; full
+        // and half scale (where a pixel is two canonical units).
+        let cases = [
+            (gentle(), PixelScale::UNIT, RectI::new(-12, -7, 251, 170)),
+            (curved(), PixelScale::UNIT, RectI::new(-12, -7, 251, 170)),
+            (
+                gentle(),
+                PixelScale::new(0.5, 0.5, 1.0),
+                RectI::new(-5, -3, 123, 84),
+            ),
+        ];
+        for (n, (warp, scale, window)) in cases.into_iter().enumerate() {
+            let exact = warp.map_window(window, scale);
+            let mut pos = vec![[0f32; 2]; window.area()];
+            let (solved, cells) = warp
+                .map_grid(window, scale, MeshWarp::TOLERANCE, &mut pos)
+                .unwrap();
+            let grid = WarpMap::new(window, scale, pos);
+            let rendered = warp.clone().within(MeshWarp::TOLERANCE);
+            let rendered = rendered.map_window(window, scale);
+            for j in window.y1..window.y2 {
+                assert_eq!(rendered.row(j), grid.row(j), "case {n}: row {j}");
+            }
+            let mut worst = 0.0f64;
+            for j in window.y1..window.y2 {
+                for i in window.x1..window.x2 {
+                    worst = worst.max(grid.get(i, j).distance(exact.get(i, j)));
+                }
+            }
+            // Rounding to f32 adds up to 1e-5 px.
+            assert!(
+                worst * scale.x <= MeshWarp::TOLERANCE + 2e-5,
+                "case {n}: {worst} px from the exact map"
+            );
+            // The gentle mesh must interpolate all but the cells along the
+            // mesh's and the window's edges (a quarter of them at half
+            // scale), or this test would pass by solving every pixel; the
+            // curved one bends too fast for the grid in most cells.
+            let share = solved as f64 / cells as f64;
+            let (lo, hi) = [(0.0, 0.2), (0.5, 1.0), (0.0, 0.3)][n];
+            assert!(
+                (lo..hi).contains(&share),
+                "case {n}: {solved} of {cells} solved"
+            );
+        }
     }
 
     #[test]
