@@ -363,11 +363,26 @@ impl Trail {
 impl MeshWarp {
     /// Row `j` of the map, pixels `x1..`, into `out`.
     fn map_row(&self, x1: i32, j: i32, scale: PixelScale, out: &mut [[f32; 2]]) {
+        let points = (0..out.len()).map(|k| scale.pixel_centre(x1 + k as i32, j));
+        self.locate_run(points, None, |k, q, _| out[k] = [q.x as f32, q.y as f32]);
+    }
+
+    /// `points` of one row mapped in turn, each starting Newton where the
+    /// row's last two solutions point (the first from `seed`): `emit(k,
+    /// where it maps, its parameters)` for the `k`th. [`MeshWarp::rows4`]
+    /// does this for four rows at once.
+    fn locate_run(
+        &self,
+        points: impl Iterator<Item = Vec2>,
+        seed: Option<Params>,
+        mut emit: impl FnMut(usize, Vec2, Option<Params>),
+    ) {
         let mut trail = Trail::default();
-        for (k, o) in out.iter_mut().enumerate() {
-            let (q, g) = self.locate(scale.pixel_centre(x1 + k as i32, j), trail.guess());
-            trail.push(g);
-            *o = [q.x as f32, q.y as f32];
+        trail.push(seed);
+        for (k, p) in points.enumerate() {
+            let (q, at) = self.locate(p, trail.guess());
+            trail.push(at);
+            emit(k, q, at);
         }
     }
 }

@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use super::{MeshWarp, Params, Trail, LANES};
+use super::{MeshWarp, Params, LANES};
 use crate::geom::{PixelScale, RectI, Vec2};
 
 /// Most pixels between grid nodes.
@@ -205,14 +205,10 @@ impl MeshWarp {
         }
         js.iter()
             .map(|&j| {
-                let mut trail = Trail::default();
-                xs.iter()
-                    .map(|&i| {
-                        let (q, at) = self.locate(px.centre(i, j), trail.guess());
-                        trail.push(at);
-                        node(q, at)
-                    })
-                    .collect()
+                let mut row = Vec::with_capacity(xs.len());
+                let points = xs.iter().map(|&i| px.centre(i, j));
+                self.locate_run(points, None, |_, q, at| row.push(node(q, at)));
+                row
             })
             .collect()
     }
@@ -250,16 +246,11 @@ impl MeshWarp {
             });
             return;
         }
-        let seed = cell.corners.iter().find_map(|n| n.at);
         for j in cell.rows.clone() {
-            let row = &mut band[(j - j0) * w..][..w];
-            let mut trail = Trail::default();
-            trail.push(seed);
-            for i in cell.columns.clone() {
-                let (q, at) = self.locate(px.centre(i, j), trail.guess());
-                trail.push(at);
-                row[i] = [q.x as f32, q.y as f32];
-            }
+            let row = &mut band[(j - j0) * w..][cell.columns.clone()];
+            let points = cell.columns.clone().map(|i| px.centre(i, j));
+            let put = |k: usize, q: Vec2, _| row[k] = [q.x as f32, q.y as f32];
+            self.locate_run(points, cell.seed(j), put);
         }
     }
 
@@ -294,13 +285,13 @@ impl Cell<'_> {
     }
 
     /// A start for Newton at the left end of pixel row `j`: its left nodes'
-    /// parameters, interpolated, or either where one is off the mesh.
+    /// parameters, interpolated, or any node's on the mesh.
     fn seed(&self, j: usize) -> Option<Params> {
         let [_, (y0, y1)] = self.knots;
         let f = (j - y0) as f64 / (y1 - y0) as f64;
         match (self.corners[0].at, self.corners[2].at) {
             (Some(a), Some(b)) => Some((a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f)),
-            (a, b) => a.or(b),
+            _ => self.corners.iter().find_map(|n| n.at),
         }
     }
 }
