@@ -91,23 +91,15 @@ fn run_cargo(mut c: Command) {
     }
 }
 
-/// The core's unit tests again as x86-64-v3 code, which is what the
+/// The core's and the plugin's unit tests again as x86-64-v3 code, which is what the
 /// bundle's fast build runs: with FMA the resampling kernels take paths
 /// (two bilinear pixels per vector) that baseline code leaves out, and
 /// their bit-exactness tests must see them. Skipped on a CPU without AVX2
 /// and FMA, which could not run that code.
 fn core_tests_fast() {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if cpu_runs_fast_build() {
         let (mut c, _) = fast_cargo();
-        c.args([
-            "test",
-            "--package",
-            "morphfx",
-            "--lib",
-            "--features",
-            "testing",
-        ]);
+        c.arg("test").args(FAST_TEST_SELECTION);
         run_cargo(c);
         return;
     }
@@ -137,14 +129,26 @@ fn bundle(release: bool) -> PathBuf {
 fn bundle_in(release: bool, folder: &str) -> PathBuf {
     let baseline = build_plugin(release, false);
     let fast = cfg!(target_arch = "x86_64").then(|| build_plugin(release, true));
+    lay_out(folder, &baseline, fast.as_deref())
+}
+
+/// Lays out `target/FOLDER/MorphFX.ofx.bundle` from built plugin binaries:
+/// `plugin` as `MorphFX.ofx` and, when given, the x86-64-v3 build beside it.
+fn lay_out(folder: &str, plugin: &Path, fast: Option<&Path>) -> PathBuf {
     let bundle = target_dir().join(folder).join("MorphFX.ofx.bundle");
     for arch in arch_folders() {
         let bin_dir = bundle.join("Contents").join(arch);
         std::fs::create_dir_all(&bin_dir).expect("create bundle folders");
-        std::fs::copy(&baseline, bin_dir.join("MorphFX.ofx")).expect("copy the plugin binary");
-        if let Some(fast) = &fast {
-            std::fs::copy(fast, bin_dir.join("MorphFX-x86-64-v3.so"))
-                .expect("copy the x86-64-v3 plugin binary");
+        std::fs::copy(plugin, bin_dir.join("MorphFX.ofx")).expect("copy the plugin binary");
+        let fast_path = bin_dir.join("MorphFX-x86-64-v3.so");
+        match fast {
+            Some(fast) => {
+                std::fs::copy(fast, &fast_path).expect("copy the x86-64-v3 plugin binary");
+            }
+            // A stale fast build would take over from this one.
+            None => {
+                let _ = std::fs::remove_file(&fast_path);
+            }
         }
     }
     let plist =
@@ -181,21 +185,7 @@ fn main() {
                 exit(status.code().unwrap_or(1));
             }
         }
-        Some("test") => {
-            let b = bundle(false);
-            // Tests find the bundle through this variable.
-            unsafe_env("MORPHFX_BUNDLE", &b);
-            ensure_openimageio();
-            let mut run = vec!["test", "--workspace"];
-            run.extend(args[1..].iter().map(String::as_str));
-            cargo(&run);
-            core_tests_fast();
-            release_concurrency(&b);
-            docs();
-            refhost::check(&b);
-            farm::check(&morphfx_binary(), &b);
-            cmake_install_check();
-        }
+        Some("test") => test(&args[1..]),
         _ => {
             eprintln!(
                 "usage: cargo xtask bundle [--release] | demo [-o DIR] | test [cargo test args] | refhost | farm"
@@ -204,6 +194,58 @@ fn main() {
         }
     }
 }
+
+/// The README's test command: every test, then the checks against tools
+/// and hosts we did not write.
+fn test(cargo_args: &[String]) {
+    let b = build_for_tests();
+    // Tests find the bundle through this variable.
+    unsafe_env("MORPHFX_BUNDLE", &b);
+    ensure_openimageio();
+    let mut run = vec!["test", "--workspace"];
+    run.extend(cargo_args.iter().map(String::as_str));
+    cargo(&run);
+    core_tests_fast();
+    release_concurrency(&b);
+    docs();
+    refhost::check(&b);
+    farm::check(&target_dir().join("debug").join("morphfx"), &b);
+    cmake_install_check();
+}
+
+/// Builds what the tests run, each in one cargo call per CPU level, and
+/// lays out the dev bundle. One call per level matters for time: cargo
+/// unifies features over the packages and targets of a call, and the test
+/// targets' dev-dependencies (the core's `testing`, criterion's serde) change
+/// them, so building the plugin alone and then the tests compiled the core,
+/// the plugin and the `morphfx` binary twice (a fifth of a cold run). The
+/// test binaries, the `morphfx` binary the farm check runs and the plugin
+/// in the bundle are the very artefacts `cargo test` then reuses.
+fn build_for_tests() -> PathBuf {
+    let fast = cfg!(target_arch = "x86_64").then(|| {
+        let (mut c, dir) = fast_cargo();
+        c.args(["build"]).args(FAST_TEST_SELECTION);
+        run_cargo(c);
+        dir.join("debug").join("libmorphfx_ofx.so")
+    });
+    cargo(&["build", "--workspace", "--lib", "--bins", "--tests"]);
+    let baseline = target_dir().join("debug").join("libmorphfx_ofx.so");
+    lay_out("bundle", &baseline, fast.as_deref())
+}
+
+/// The x86-64-v3 build's packages, targets and features: the same for its
+/// build (which also leaves the plugin binary) and its test run, so the
+/// second compiles nothing.
+const FAST_TEST_SELECTION: &[&str] = &[
+    "--package",
+    "morphfx",
+    "--package",
+    "morphfx-ofx",
+    "--lib",
+    "--tests",
+    "--features",
+    "morphfx/testing",
+];
 
 /// The `morphfx` binary of the dev profile, built if need be.
 fn morphfx_binary() -> PathBuf {
@@ -218,22 +260,30 @@ fn morphfx_binary() -> PathBuf {
     target_dir().join("debug").join("morphfx")
 }
 
-/// The concurrency test again with the plugin and the test built in the
-/// release profile: optimised code reorders and inlines more, and has no
-/// overflow checks, so races and arithmetic it hides in a debug build show
-/// here.
+/// The concurrency test again on the plugin built in the release profile:
+/// optimised code reorders and inlines more, and has no overflow checks, so
+/// races and arithmetic a debug build hides show here. The build is the
+/// one this CPU runs (the x86-64-v3 build where the CPU has AVX2 and FMA,
+/// as the bundle's hand-over picks), so only it is compiled; the host side,
+/// the dev test binary already built, only drives it.
 fn release_concurrency(dev_bundle: &Path) {
-    let b = bundle_in(true, "bundle-release");
+    let plugin = build_plugin(true, cpu_runs_fast_build());
+    let b = lay_out("bundle-release", &plugin, None);
     unsafe_env("MORPHFX_BUNDLE", &b);
-    cargo(&[
-        "test",
-        "--release",
-        "--package",
-        "morphfx-harness",
-        "--test",
-        "concurrency",
-    ]);
+    // `--workspace`, as the test build: the same features, nothing rebuilt.
+    cargo(&["test", "--workspace", "--test", "concurrency"]);
     unsafe_env("MORPHFX_BUNDLE", dev_bundle);
+}
+
+/// Whether this CPU has AVX2 and FMA, so that the bundle runs its x86-64-v3
+/// build here.
+fn cpu_runs_fast_build() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    false
 }
 
 /// `cargo doc --no-deps` with rustdoc's warnings denied: a broken link or
