@@ -209,8 +209,9 @@ fn test(cargo_args: &[String]) {
     release_concurrency(&b);
     docs();
     refhost::check(&b);
-    farm::check(&target_dir().join("debug").join("morphfx"), &b);
-    cmake_install_check();
+    let morphfx = target_dir().join("debug").join("morphfx");
+    farm::check(&morphfx, &b);
+    cmake_install_check(&morphfx);
 }
 
 /// Builds what the tests run, each in one cargo call per CPU level, and
@@ -327,13 +328,16 @@ fn ensure_openimageio() {
 
 /// `cmake -S . -B build && cmake --build build && cmake --install build --prefix P`
 /// must leave a bundle under `P/OFX/Plugins` that a host can load: checked by
-/// listing its plugins through the C ABI with `morphfx plugins`.
-fn cmake_install_check() {
+/// listing its plugins through the C ABI with `morphfx` (the dev binary the
+/// tests ran). cargo builds into the workspace's `target`, where the release
+/// concurrency check left the x86-64-v3 plugin, rather than compiling both
+/// release plugins afresh in the build folder.
+fn cmake_install_check(morphfx: &Path) {
     if !tools::runs("cmake", &["--version"]) {
         println!("cmake install check: skipped (cmake is not installed)");
         return;
     }
-    let dir = root().join("target").join("cmake-check");
+    let dir = target_dir().join("cmake-check");
     let _ = std::fs::remove_dir_all(dir.join("prefix"));
     let (build, prefix) = (dir.join("build"), dir.join("prefix"));
     let run = |args: &[&std::ffi::OsStr]| {
@@ -347,11 +351,13 @@ fn cmake_install_check() {
             exit(1);
         }
     };
+    let cargo_target = format!("-DMORPHFX_TARGET_DIR={}", target_dir().display());
     run(&[
         "-S".as_ref(),
         ".".as_ref(),
         "-B".as_ref(),
         build.as_os_str(),
+        cargo_target.as_ref(),
     ]);
     run(&["--build".as_ref(), build.as_os_str()]);
     run(&[
@@ -361,7 +367,9 @@ fn cmake_install_check() {
         prefix.as_os_str(),
     ]);
     let installed = prefix.join("OFX/Plugins/MorphFX.ofx.bundle");
-    let out = morphfx(false, &installed)
+    let out = Command::new(morphfx)
+        .arg("--bundle")
+        .arg(&installed)
         .arg("plugins")
         .output()
         .expect("morphfx runs");
