@@ -143,6 +143,34 @@ fn bench_resample(c: &mut Criterion) {
                 .for_each(|(d, s)| d.copy_from_slice(s))
         })
     });
+    // The copy's two halves: reading a frame (summed in eight lanes, which
+    // vectorise) and writing one. With the map's read (8 of a pixel's 16
+    // bytes, half a `read_floor`) they give what a resample costs when
+    // memory streams at its best: the model docs/PERFORMANCE.md compares
+    // `bilinear` and `bilinear_shift` with.
+    g.bench_function("read_floor", |b| {
+        b.iter(|| {
+            use rayon::prelude::*;
+            let lanes = |s: &[f32]| {
+                let mut acc = [0.0f32; 8];
+                for c in s.as_chunks::<8>().0 {
+                    for (a, v) in acc.iter_mut().zip(c) {
+                        *a += v;
+                    }
+                }
+                acc.iter().sum::<f32>()
+            };
+            black_box(src.data.par_chunks(W as usize * 4).map(lanes).sum::<f32>())
+        })
+    });
+    g.bench_function("write_floor", |b| {
+        b.iter(|| {
+            use rayon::prelude::*;
+            dst.data
+                .par_chunks_mut(W as usize * 4)
+                .for_each(|d| d.fill(black_box(0.5)))
+        })
+    });
     for filter in [Filter::Bilinear, Filter::Bicubic] {
         let settings = ResampleSettings {
             filter,
