@@ -3,7 +3,7 @@
 //! memory: reading plates is the harness's part, timed separately in
 //! docs/PERFORMANCE.md).
 //!
-//! `cargo bench --bench track`
+//! `cargo bench --features bench --bench track`
 
 use std::hint::black_box;
 use std::sync::Arc;

@@ -6,7 +6,7 @@
 //! The overlay: 60 shapes of 20 points each in Scene Text drawn through
 //! the Draw suite, hovered and dragged, against parsing the same text.
 //!
-//! `cargo xtask bundle --release && cargo bench -p morphfx-harness --bench plugin`
+//! `cargo xtask bundle --release && cargo bench -p morphfx-harness --features bench --bench plugin`
 
 use std::hint::black_box;
 use std::path::PathBuf;
