@@ -63,6 +63,11 @@ fn build_plugin(release: bool, fast: bool) -> PathBuf {
         c.arg("--release");
     }
     run_cargo(c);
+    plugin_binary(&dir, profile)
+}
+
+/// The plugin library cargo leaves in target folder `dir` for `profile`.
+fn plugin_binary(dir: &Path, profile: &str) -> PathBuf {
     dir.join(profile).join("libmorphfx_ofx.so")
 }
 
@@ -122,14 +127,9 @@ fn arch_folders() -> &'static [&'static str] {
 /// baseline build as `MorphFX.ofx` and, on x86-64, the x86-64-v3 build beside
 /// it, which the baseline build hands over to on CPUs with AVX2 and FMA.
 fn bundle(release: bool) -> PathBuf {
-    bundle_in(release, "bundle")
-}
-
-/// [`bundle`], laid out under `target/FOLDER`.
-fn bundle_in(release: bool, folder: &str) -> PathBuf {
     let baseline = build_plugin(release, false);
     let fast = cfg!(target_arch = "x86_64").then(|| build_plugin(release, true));
-    lay_out(folder, &baseline, fast.as_deref())
+    lay_out("bundle", &baseline, fast.as_deref())
 }
 
 /// Lays out `target/FOLDER/MorphFX.ofx.bundle` from built plugin binaries:
@@ -227,10 +227,10 @@ fn build_for_tests() -> PathBuf {
         let (mut c, dir) = fast_cargo();
         c.args(["build"]).args(FAST_TEST_SELECTION);
         run_cargo(c);
-        dir.join("debug").join("libmorphfx_ofx.so")
+        plugin_binary(&dir, "debug")
     });
     cargo(&["build", "--workspace", "--lib", "--bins", "--tests"]);
-    let baseline = target_dir().join("debug").join("libmorphfx_ofx.so");
+    let baseline = plugin_binary(&target_dir(), "debug");
     lay_out("bundle", &baseline, fast.as_deref())
 }
 
