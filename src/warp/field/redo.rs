@@ -16,7 +16,7 @@ use super::kernel::Lines;
 use super::split::{fill_band, Band, Setup};
 use super::weight::Weight;
 use super::{Evaluation, FieldWarp, LinePair};
-use crate::geom::{PixelScale, RectI, Vec2};
+use crate::geom::{PixelScale, RectI};
 use crate::image::WarpMap;
 
 /// Redos in a row before a full evaluation again: each rounds the kept
@@ -121,8 +121,6 @@ struct Moved<'a> {
     before: &'a FieldMap,
     old: Lines,
     new: Lines,
-    /// Their destination segments before and after, in pixel space.
-    segments: Vec<(Vec2, Vec2)>,
 }
 
 impl<'a> Moved<'a> {
@@ -146,30 +144,26 @@ impl<'a> Moved<'a> {
             return None;
         }
         let pick = |pairs: &[LinePair]| moved.iter().map(|&k| pairs[k]).collect::<Vec<_>>();
-        let (old, new) = (pick(&before.pairs), pick(&warp.pairs));
-        let to_pixel =
-            |l: &LinePair| (setup.scale.to_pixel(l.dst.0), setup.scale.to_pixel(l.dst.1));
         Some(Moved {
             before,
-            old: Lines::new(&old, &warp.weight),
-            new: Lines::new(&new, &warp.weight),
-            segments: old.iter().chain(&new).map(to_pixel).collect(),
+            old: Lines::new(&pick(&before.pairs), &warp.weight),
+            new: Lines::new(&pick(&warp.pairs), &warp.weight),
         })
     }
 
     /// A band of the new map: `first` numbers its first block, and `made`
     /// gets whether each block's far field is interpolated (as it was).
     /// Blocks are shifted row by row across the whole band (the map is read
-    /// and written in the order it lies in memory); those the moved lines
-    /// come near, or where some pixel's sums cannot take the shift, are
-    /// evaluated afresh.
+    /// and written in the order it lies in memory); those where some pixel's
+    /// sums cannot take the shift are evaluated afresh.
+    ///
+    /// A block the moved lines come near needs no more than that: their
+    /// terms are swapped exactly wherever they lie, so whether a fresh block
+    /// would have put them among its near lines or its far grid changes
+    /// nothing but how exactly they are counted (see [`Self::shift`]).
+    /// Near them the swap's weight check is what refuses a block.
     fn redo(&self, band: &mut Band, first: usize, made: &mut [bool]) {
-        let mut fresh: Vec<bool> = (0..made.len())
-            .map(|k| {
-                let b = band.block(k);
-                self.segments.iter().any(|&s| b.is_near(s))
-            })
-            .collect();
+        let mut fresh = vec![false; made.len()];
         self.shift(band, &mut fresh);
         for (k, made) in made.iter_mut().enumerate() {
             *made = match fresh[k] {
@@ -187,6 +181,9 @@ impl<'a> Moved<'a> {
     /// interpolation error in the sums (checked when the block was made) is
     /// untouched, and it moves the position by about as much while the
     /// total weight changes by a tenth or less, which [`swap_terms`] holds.
+    /// That holds as well where a moved line was one of a block's far lines:
+    /// its old term's share of that error stays, as it was, and its new term
+    /// is exact.
     fn shift(&self, band: &mut Band, fresh: &mut [bool]) {
         let setup = band.setup;
         let (window, scale) = (setup.window, setup.scale);

@@ -81,6 +81,34 @@ fn redos_while_a_line_is_dragged_stay_within_tolerance_of_the_exact_map() {
     }
 }
 
+/// Blocks the dragged line comes near are shifted too, not made afresh:
+/// a line dragged across the frame, in and out of many blocks' near sets,
+/// through many redos in a row, keeps the map within tolerance.
+#[test]
+fn a_line_dragged_across_many_blocks_stays_within_tolerance() {
+    let tolerance = Evaluation::DEFAULT_TOLERANCE;
+    for (seed, scale) in [(7, 1.0), (8, 0.5)] {
+        let (window, scale) = window_at(scale);
+        let mut pairs = spread_pairs(seed, 30, 640.0, 360.0);
+        let mut kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+        for step in 1..=24 {
+            pairs = drag(&pairs, 2, v(14.0, 9.0));
+            let warp = FieldWarp::new(pairs.clone(), &adaptive());
+            kept = warp.field_map_after(window, scale, Some(&kept));
+            assert_eq!(kept.redos(), step, "seed {seed}: a redo, not a fresh map");
+            if step % 6 == 0 {
+                let truth = FieldWarp::new(pairs.clone(), &exact(0.001)).map_window(window, scale);
+                let err = worst_px(kept.map(), &truth);
+                assert!(
+                    err <= tolerance,
+                    "seed {seed}, scale {}, drag {step}: {err} px from exact > {tolerance}",
+                    scale.x
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn an_exact_redo_matches_the_fresh_exact_map() {
     let (window, scale) = window_at(1.0);

@@ -275,13 +275,6 @@ impl Block<'_> {
         )
     }
 
-    /// Whether segment `p→q` (pixel space) is near enough to this block to
-    /// be among its exactly evaluated lines.
-    pub fn is_near(&self, (p, q): (Vec2, Vec2)) -> bool {
-        let (lo, hi) = self.corners();
-        is_near(p, q, lo, hi)
-    }
-
     /// Canonical position of the centre of pixel `(i, j)`.
     fn centre(&self, i: i32, j: i32) -> (f32, f32) {
         let c = self.setup.scale.pixel_centre(i, j);
