@@ -163,8 +163,7 @@ impl<'a> Moved<'a> {
     /// nothing but how exactly they are counted (see [`Self::shift`]).
     /// Near them the swap's weight check is what refuses a block.
     fn redo(&self, band: &mut Band, first: usize, made: &mut [bool]) {
-        let mut fresh = vec![false; made.len()];
-        self.shift(band, &mut fresh);
+        let fresh = self.shift(band, made.len());
         for (k, made) in made.iter_mut().enumerate() {
             *made = match fresh[k] {
                 true => band.block(k).fill(),
@@ -174,8 +173,9 @@ impl<'a> Moved<'a> {
     }
 
     /// Swaps the moved lines' old terms for their new ones, evaluated
-    /// exactly, in every pixel of the band's blocks not `fresh`, row by row;
-    /// a block where some pixel's sums cannot take it becomes `fresh`.
+    /// exactly, in every pixel of the band's `blocks`, row by row, and says
+    /// which blocks some pixel's sums could not take it in (from that row
+    /// on they are skipped, to be evaluated afresh).
     ///
     /// Exact terms leave each pixel's error what it was: the far field's
     /// interpolation error in the sums (checked when the block was made) is
@@ -184,12 +184,10 @@ impl<'a> Moved<'a> {
     /// That holds as well where a moved line was one of a block's far lines:
     /// its old term's share of that error stays, as it was, and its new term
     /// is exact.
-    fn shift(&self, band: &mut Band, fresh: &mut [bool]) {
+    fn shift(&self, band: &mut Band, blocks: usize) -> Vec<bool> {
         let setup = band.setup;
         let (window, scale) = (setup.window, setup.scale);
-        if fresh.iter().all(|&f| f) {
-            return;
-        }
+        let mut fresh = vec![false; blocks];
         let xs: Vec<f32> = (window.x1..window.x2)
             .map(|i| scale.pixel_centre(i, band.y1).x as f32)
             .collect();
@@ -219,6 +217,7 @@ impl<'a> Moved<'a> {
                 }
             }
         }
+        fresh
     }
 }
 
