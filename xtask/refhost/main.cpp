@@ -311,10 +311,11 @@ int choiceCount(IE::Instance &fx, const std::string &name) {
 /// sends it (`kOfxImageEffectPropInteractiveRenderStatus` 1, not
 /// sequential): interactive renders after each move, where the plugin may
 /// redo its maps from the last ones, end at the picture a sequential
-/// render of the same lines makes afresh. In this 96 × 64 frame every block
-/// lies within the moved line's reach, so the redo remakes each block and
-/// the two agree exactly; the swap of far blocks is held by the harness's
-/// `tests/drag.rs` at 320 × 180.
+/// render of the same lines makes afresh, within 0.01 (a hundredth of the
+/// unit range). The redo swaps the moved line's terms in every block here,
+/// near ones included, and remakes only those whose weights refuse the
+/// swap; its distance from the exact map at 320 × 180 is held by the
+/// harness's `tests/drag.rs`.
 void checkDrag(Effect &fx, const Where &w) {
   auto *text = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_text"));
   auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("method"));

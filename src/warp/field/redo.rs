@@ -5,10 +5,11 @@
 //! `X + (S − s_old + s_new) / (W − w_old + w_new)`, with `S = (X′ − X)·W`
 //! read back from the map before and `W` kept beside it.
 //!
-//! Blocks the moved lines come near (before or after) are evaluated afresh,
-//! since their split into near and far lines changes there, and so is any
-//! block with a pixel where the moved lines carry a tenth of the weight or
-//! more. Everywhere else only the moved lines are evaluated, at every pixel.
+//! Only the moved lines are evaluated, exactly, at every pixel; a block with
+//! a pixel where they carry a tenth of the weight or more is evaluated
+//! afresh. Blocks they come near need nothing more: whether a fresh block
+//! would count them among its near lines or its far grid, exact terms
+//! swapped in leave the sums' error as it was.
 
 use std::sync::Arc;
 
