@@ -167,8 +167,7 @@ fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
             compression: None,
         });
     }
-    let meta =
-        exr::meta::MetaData::read_from_file(path, false).map_err(|e| exr_read_error(path, e))?;
+    let meta = read_exr_meta(path)?;
     let header = meta
         .headers
         .first()
@@ -191,6 +190,108 @@ fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
         half,
         compression: Some(header.compression),
     })
+}
+
+/// Counts the bytes a reader hands on: where an EXR's headers end.
+struct Counted<R> {
+    inner: R,
+    read: u64,
+}
+
+impl<R: std::io::Read> std::io::Read for Counted<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.read += n as u64;
+        Ok(n)
+    }
+}
+
+/// An EXR's headers, and its chunk table checked against the file's length:
+/// a file cut short (a copy that stopped, a full disk) is refused here, from
+/// its header, before anything is rendered or written, rather than when its
+/// pixels are decoded frames later. Damage inside the pixels themselves
+/// still surfaces only when they are decoded.
+fn read_exr_meta(path: &Path) -> std::result::Result<exr::meta::MetaData, HostError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let io_error = |e: std::io::Error| exr_read_error(path, e.into());
+    let file = std::fs::File::open(path).map_err(io_error)?;
+    let length = file.metadata().map_err(io_error)?.len();
+    let mut counted = Counted {
+        inner: std::io::BufReader::new(file),
+        read: 0,
+    };
+    let meta = exr::meta::MetaData::read_from_buffered(&mut counted, false)
+        .map_err(|e| exr_read_error(path, e))?;
+    if meta.headers.iter().any(|h| h.deep) {
+        return Ok(meta); // refused later, by the reader that skips deep data
+    }
+    // A header too large to render is named as such, not as cut short.
+    if let Some(h) = meta.headers.first() {
+        let display = h.shared_attributes.display_window.size;
+        check_size(
+            path,
+            "data window",
+            (h.layer_size.width(), h.layer_size.height()),
+        )?;
+        check_size(path, "display window", (display.width(), display.height()))?;
+    }
+    // The offset tables follow the headers: one u64 per chunk.
+    let chunks: u64 = meta.headers.iter().map(|h| h.chunk_count as u64).sum();
+    let table_end = counted.read.saturating_add(chunks.saturating_mul(8));
+    let cut = |what: String| {
+        HostError::bad(format!(
+            "{}: cannot read EXR: the file ends before its header or pixels do: it is truncated ({what}; the file has {length} bytes)",
+            path.display()
+        ))
+    };
+    if table_end > length {
+        return Err(cut(format!("its chunk table ends at byte {table_end}")));
+    }
+    let mut table = vec![0u8; (chunks * 8) as usize];
+    counted.read_exact(&mut table).map_err(io_error)?;
+    let last = table
+        .chunks_exact(8)
+        .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
+        .max()
+        .unwrap_or(0);
+    // Every chunk opens with its position (a part number first in a
+    // multi-part file; four tile numbers for tiles, one line for scan
+    // lines), then its byte count.
+    let part = if meta.requirements.has_multiple_layers {
+        4
+    } else {
+        0
+    };
+    let place = match meta.headers[0].blocks {
+        exr::meta::BlockDescription::ScanLines => 4,
+        exr::meta::BlockDescription::Tiles(_) => 16,
+    };
+    let lead = part + place;
+    // Where the pixels could reach at most, had nothing been cut.
+    let room: u64 = meta
+        .headers
+        .iter()
+        .map(|h| h.max_pixel_file_bytes() as u64)
+        .sum();
+    if last < table_end || last > table_end.saturating_add(room.saturating_mul(2)) {
+        // An offset into the header, or beyond any such file: corrupt,
+        // and the reader names it.
+        return Ok(meta);
+    }
+    if last.saturating_add(lead + 4) > length {
+        return Err(cut(format!("its last chunk starts at byte {last}")));
+    }
+    let mut reader = counted.inner;
+    let mut size = [0u8; 4];
+    reader
+        .seek(SeekFrom::Start(last + lead))
+        .and_then(|_| reader.read_exact(&mut size))
+        .map_err(io_error)?;
+    let end = last + lead + 4 + u64::from(i32::from_le_bytes(size).max(0) as u32);
+    if end > length {
+        return Err(cut(format!("its last chunk ends at byte {end}")));
+    }
+    Ok(meta)
 }
 
 /// An EXR data window in canonical pixels: EXR y grows downwards, canonical y

@@ -250,13 +250,24 @@ impl Job {
             *frames.last().unwrap_or(&frames[0]) as f64,
         );
         inst.begin_sequence(range.0, range.1)?;
-        // A plate that fails to decode surfaces as a failed action; name it.
-        let read_error = |e: HostError| {
-            plates
-                .iter()
-                .chain(&job.mattes)
-                .find_map(|(_, p)| p.error.lock().unwrap_or_else(|p| p.into_inner()).take())
-                .unwrap_or(e)
+        // A plate that fails to decode fails its frame, whatever the plugin
+        // made of the missing image: a Morph node renders on without an
+        // input it cannot fetch (B alone, or black), so the render's own
+        // result cannot be trusted to say so.
+        let read_failure = |f: i64| {
+            plates.iter().chain(&job.mattes).find_map(|(clip, p)| {
+                let e = p.error.lock().unwrap_or_else(|p| p.into_inner()).take()?;
+                let frame = if is_sequence(&p.pattern) {
+                    format!(" (frame {f})")
+                } else {
+                    String::new()
+                };
+                Some(HostError::bad(format!(
+                    "{}{frame}: {}",
+                    clip_option(clip),
+                    e.message
+                )))
+            })
         };
         let mut rendering = Duration::ZERO;
         // Frame n is written while frame n + 1 renders.
@@ -294,7 +305,10 @@ impl Job {
                     // Its picture may be unfinished (the render was told to abort).
                     return Err(interrupted(writer, &frames[..n], frame_path(pattern, f)));
                 }
-                let out = out.map_err(read_error)?;
+                if let Some(e) = read_failure(f) {
+                    return Err(e);
+                }
+                let out = out?;
                 rendering += started.elapsed();
                 let plate = Plate {
                     image: out.into_image(),
@@ -342,6 +356,18 @@ pub fn interrupted(writer: WriteBehind, done: &[i64], missing: PathBuf) -> HostE
         "{}: not written: interrupted; {whole}, none after",
         missing.display()
     ))
+}
+
+/// The command-line option that feeds `clip`, as a user wrote it.
+pub fn clip_option(clip: &str) -> &str {
+    match clip {
+        "SourceA" | "SourceFrom" => "--a",
+        "SourceB" | "SourceTo" => "--b",
+        "Source" => "--input",
+        "Mask" => "--mask",
+        "Timing" => "--timing",
+        other => other,
+    }
 }
 
 /// The scene file, parsed, if one is given.

@@ -83,16 +83,23 @@ impl Job {
         show: &str,
     ) -> Result<(), HostError> {
         inst.set_choice("overlay_show", show_option(show)?)?;
-        let source = match (show, self.sources.get(1)) {
-            ("b", Some((_, b))) => b,
-            _ => &self.sources[0].1,
+        let drawn_on = match (show, self.sources.len()) {
+            ("b", 2) => 1,
+            _ => 0,
         };
         let overlay = Overlay::new(inst, true)?
             .ok_or_else(|| HostError::failed("the plugin declares no overlay"))?;
         let format = self.common.output_format(&job.inputs)?;
         let progress = Progress::new(job.frames.len());
         for (n, &f) in job.frames.iter().enumerate() {
-            let mut plate = io::read_as(&frame_path(source, f), format.colour)?;
+            // Every source is read, the one not drawn on too: a damaged
+            // input is refused whichever plate the overlay shows.
+            let mut plates = self
+                .sources
+                .iter()
+                .map(|(_, p)| io::read_as(&frame_path(p, f), format.colour))
+                .collect::<Result<Vec<_>, _>>()?;
+            let mut plate = plates.swap_remove(drawn_on);
             let calls = overlay.draw(f as f64, (1.0, 1.0))?;
             crate::raster::paint(&mut plate.image, &calls, (1.0, 1.0));
             io::write_as(&frame_path(&self.common.output, f), &plate, format)?;
