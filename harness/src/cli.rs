@@ -234,10 +234,12 @@ pub enum Command {
 
 #[derive(Subcommand)]
 pub enum JobKind {
-    /// An Open Job Description job bundle (template.yaml with the command's
-    /// values as defaults, parameter_values.yaml as Deadline Cloud takes
-    /// them): `morphfx job openjd -o DIR -- morph --scene S --a A --b B
-    /// --frames 1001-1048 -o OUT`.
+    /// An Open Job Description job bundle: template.yaml (the project's
+    /// template), the command's values in parameter_values.yaml (as Deadline
+    /// Cloud takes them) and openjd_parameters.json (for `openjd run`):
+    /// `morphfx job openjd -o DIR -- morph --scene S --a A --b B
+    /// --frames 1001-1048 -o OUT`. The command is checked first, as a worker
+    /// would check it.
     Openjd {
         /// The job bundle's folder.
         #[arg(short = 'o', long = "output")]

@@ -36,28 +36,9 @@ fn run(cli: Cli) -> Result<(), HostError> {
     let bundle_path = || find_bundle(cli.bundle.as_deref(), &cli.plugin_path);
     match cli.command {
         Command::Plugins => plugins::list_plugins(&bundle_path()?),
-        Command::Morph {
-            common,
-            a,
-            b,
-            stmap_a,
-            stmap_b,
-            view,
-            mask,
-            timing,
-            context,
-        } => job::morph_job(common, a, b, [stmap_a, stmap_b], view, &context)?
-            .with_mattes(mask, timing)
-            .run(&bundle_path()?),
-        Command::Warp {
-            common,
-            input,
-            stmap,
-            view,
-            mask,
-        } => job::warp_job(common, input, stmap, view)
-            .with_mattes(mask, None)
-            .run(&bundle_path()?),
+        command @ (Command::Morph { .. } | Command::Warp { .. }) => {
+            render_job(command)?.run(&bundle_path()?)
+        }
         Command::Params { node } => params::list_params(&bundle_path()?, node.as_deref()),
         Command::Demo { output } => demo::demo(&bundle_path()?, &output),
         Command::Overlay {
@@ -116,14 +97,21 @@ fn run(cli: Cli) -> Result<(), HostError> {
                     morphfx,
                     command,
                 },
-        } => openjd::write_bundle(&openjd::Job {
-            dir: &output,
-            chunk_size,
-            chunk_target_runtime,
-            morphfx: &morphfx,
-            plugin_path: cli.bundle.as_deref(),
-            command: &command,
-        }),
+        } => {
+            let job = openjd::Job {
+                dir: &output,
+                chunk_size,
+                chunk_target_runtime,
+                morphfx: &morphfx,
+                plugin_path: cli.bundle.as_deref(),
+                command: &command,
+            };
+            // Checked as a worker would check it: a job that cannot run
+            // is refused at submission, not on the farm.
+            openjd::write_bundle(&job, || {
+                submitted_job(&command)?.check_submission(&bundle_path()?)
+            })
+        }
         Command::Bench {
             drag: true,
             width,
@@ -139,4 +127,52 @@ fn run(cli: Cli) -> Result<(), HostError> {
             ..
         } => bench::bench(&bundle_path()?, &output, frames, (width, height)),
     }
+}
+
+/// The render a `morph` or `warp` command asks for.
+fn render_job(command: Command) -> Result<job::Job, HostError> {
+    match command {
+        Command::Morph {
+            common,
+            a,
+            b,
+            stmap_a,
+            stmap_b,
+            view,
+            mask,
+            timing,
+            context,
+        } => Ok(
+            job::morph_job(common, a, b, [stmap_a, stmap_b], view, &context)?
+                .with_mattes(mask, timing),
+        ),
+        Command::Warp {
+            common,
+            input,
+            stmap,
+            view,
+            mask,
+        } => Ok(job::warp_job(common, input, stmap, view).with_mattes(mask, None)),
+        _ => Err(HostError::bad(
+            "morphfx job openjd: a farm job runs morph or warp",
+        )),
+    }
+}
+
+/// The render a farm job's command line (`morph ...` or `warp ...`) asks
+/// for, parsed as the workers will parse it.
+fn submitted_job(command: &[String]) -> Result<job::Job, HostError> {
+    let words = std::iter::once("morphfx".to_owned()).chain(command.iter().cloned());
+    let words = morphfx_harness::cli::expand_extra_args(words.map(Into::into));
+    let cli = Cli::try_parse_from(words).map_err(|e| {
+        let first = e.to_string();
+        let first = first
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .trim_start_matches("error: ")
+            .to_owned();
+        HostError::bad(format!("morphfx job openjd: the command after --: {first}"))
+    })?;
+    render_job(cli.command)
 }

@@ -22,6 +22,12 @@ pub fn frame_path(pattern: &str, frame: i64) -> PathBuf {
     ))
 }
 
+/// `--frames` in Open Job Description's range form: `x` steps become `:`
+/// (OpenJD takes `1001-1011:5`, not OpenCue's and Nuke's `1001-1011x5`).
+pub fn openjd_frames(spec: &str) -> String {
+    spec.replace('x', ":")
+}
+
 pub fn is_sequence(pattern: &str) -> bool {
     pattern.contains('#')
 }
@@ -73,6 +79,12 @@ pub fn parse_frames(spec: &str) -> Result<Vec<i64>, HostError> {
             return Err(bad(&format!("more than {MAX_FRAMES} frames")));
         }
         frames.extend((0..count as i64).map(|k| a + k * step));
+    }
+    // A frame named twice would be rendered and written twice, and a
+    // farm's chunks holding it would race on its file.
+    let mut seen = std::collections::HashSet::with_capacity(frames.len());
+    if let Some(f) = frames.iter().find(|f| !seen.insert(**f)) {
+        return Err(bad(&format!("frame {f} is named twice")));
     }
     Ok(frames)
 }

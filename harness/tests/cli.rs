@@ -556,3 +556,89 @@ fn bench_drag_times_renders_after_a_move_at_both_scales() {
     let bad = common::run_morphfx(&["bench", "--drag", "--moves", "0"]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// Several frames into one file name would overwrite it frame after frame:
+/// refused before anything is rendered, as is a frame named twice.
+#[test]
+fn several_frames_need_a_numbered_output_and_each_frame_once() {
+    let d = tmp("one-name");
+    let a = plate(&d, "a.exr", 32, 24, 0.0);
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    let scene = d.join("s.morph.json");
+    let scene = scene.to_str().unwrap();
+    let one = d.join("one.exr");
+    let st = d.join("st.####.exr");
+    let seq = d.join("w.####.exr");
+    for (frames, out, stmap, why) in [
+        (
+            "1-3",
+            one.to_str().unwrap(),
+            st.to_str().unwrap(),
+            "3 frames would overwrite one file",
+        ),
+        (
+            "1-3",
+            seq.to_str().unwrap(),
+            one.to_str().unwrap(),
+            "3 frames would overwrite one file",
+        ),
+        (
+            "1,2,1",
+            seq.to_str().unwrap(),
+            st.to_str().unwrap(),
+            "frame 1 is named twice",
+        ),
+    ] {
+        let (code, err) = morphfx(&[
+            "warp", "--scene", scene, "--input", &a, "--frames", frames, "-o", out, "--stmap",
+            stmap,
+        ]);
+        assert_eq!(code, 2, "{frames} {out}: {err}");
+        assert!(err.contains(why), "{err}");
+        assert_eq!(
+            std::fs::read_dir(&d).unwrap().count(),
+            2,
+            "something was written"
+        );
+    }
+}
+
+/// ST maps are 32-bit float whatever the plates' precision: a half float
+/// holds x/W to about 0.001 near 1, almost a pixel at 1920 wide.
+#[test]
+fn stmaps_are_float_from_half_plates() {
+    let d = tmp("stmap-half");
+    let (w, h) = (1920, 4);
+    let img = Image::from_fn(RectI::from_size(w, h), 4, |_, _, _| 0.5);
+    let a = d.join("a.exr");
+    io::write(&a, &Plate::new(img, (w, h)), ExrPrecision::Half).unwrap();
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    let (st, warped) = (d.join("st.exr"), d.join("w.exr"));
+    let (code, err) = morphfx(&[
+        "warp",
+        "--scene",
+        d.join("s.morph.json").to_str().unwrap(),
+        "--input",
+        a.to_str().unwrap(),
+        "--t",
+        "0",
+        "-o",
+        warped.to_str().unwrap(),
+        "--stmap",
+        st.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        io::probe(&warped).unwrap().half,
+        "the picture follows its plate"
+    );
+    assert!(!io::probe(&st).unwrap().half, "the ST map is float");
+    // At t = 0 the map is the identity: every pixel centre to 1/40 px.
+    let map = io::read(&st).unwrap().image;
+    for j in 0..h {
+        for i in (0..w).step_by(7) {
+            let s = map.data[(j * w + i) * 4] as f64 * w as f64;
+            assert!((s - (i as f64 + 0.5)).abs() < 0.025, "({i}, {j}): {s}");
+        }
+    }
+}

@@ -192,3 +192,58 @@ fn a_job_no_template_can_carry_is_refused_and_nothing_is_written() {
     assert!(err.contains("--chunk-size must be at least 1"), "{err}");
     assert!(!job.exists());
 }
+
+/// What a worker would refuse is refused at submission, nothing written:
+/// a scene that is not there, a param the node does not have, a value out
+/// of its range, a shot written to one file. A stepped range in OpenCue's
+/// and Nuke's form is written in the form OpenJD reads.
+#[test]
+fn a_job_is_checked_as_a_worker_would_before_it_is_written() {
+    let d = common::scratch("job-checked");
+    shot(&d);
+    let job = d.join("job");
+    let (scene, a) = (s(&d.join("s.morph.json")), s(&d.join("a.exr")));
+    let out = s(&d.join("out.####.exr"));
+    let submit = |extra: &[&str], frames: &str, output: &str| {
+        let mut args = vec![
+            "job",
+            "openjd",
+            "-o",
+            &*job.to_str().unwrap(),
+            "--",
+            "warp",
+            "--scene",
+        ];
+        args.extend([extra.first().copied().unwrap_or(&scene)]);
+        args.extend(["--input", &a, "--frames", frames, "-o", output]);
+        args.extend(extra.iter().skip(1));
+        common::run_morphfx(&args)
+    };
+    let missing = s(&d.join("nowhere.morph.json"));
+    for (extra, output, why) in [
+        (vec![missing.as_str()], out.as_str(), "nowhere.morph.json"),
+        (
+            vec![scene.as_str(), "--param", "no_such=1"],
+            &out,
+            "no_such",
+        ),
+        (vec![scene.as_str(), "--param", "mix=7"], &out, "mix"),
+        (
+            vec![scene.as_str()],
+            &s(&d.join("one.exr")),
+            "would overwrite one file",
+        ),
+    ] {
+        let r = submit(&extra, "1001-1011x5", output);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(why), "{extra:?}: {err}");
+        assert!(!job.exists(), "{extra:?} wrote the job");
+    }
+    let r = submit(&[&scene], "1001-1011x5", &out);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let values: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(job.join("openjd_parameters.json")).unwrap())
+            .unwrap();
+    assert_eq!(values["Frames"], "1001-1011:5");
+}

@@ -134,6 +134,7 @@ impl Job {
             }
         }
         let frames = self.frames(scene.as_ref(), &lines)?;
+        self.check_outputs(&frames)?;
         let plates: Vec<(String, Arc<Plates>)> = self
             .sources
             .iter()
@@ -160,6 +161,55 @@ impl Job {
             params,
             inputs,
         })
+    }
+
+    /// The output patterns: the view's and every extra output's.
+    fn output_patterns(&self) -> impl Iterator<Item = &str> {
+        std::iter::once(self.common.output.as_str())
+            .chain(self.extra.iter().map(|(_, p)| p.as_str()))
+    }
+
+    /// Several frames need outputs numbered by `#`: one name for all would
+    /// be overwritten frame after frame (and raced on by a farm's chunks).
+    fn check_outputs(&self, frames: &[i64]) -> Result<(), HostError> {
+        if frames.len() < 2 {
+            return Ok(());
+        }
+        match self.output_patterns().find(|p| !is_sequence(p)) {
+            Some(p) => Err(HostError::bad(format!(
+                "{p}: {} frames would overwrite one file: number the output with # \
+                 (e.g. out.####.exr)",
+                frames.len()
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// What a farm job can be checked for where it is submitted, before any
+    /// worker starts: the scene, the lines, the frames and outputs, and every
+    /// `--param` against the node the bundle makes. The plates are not read
+    /// here (a worker may see other mounts); each chunk checks them first.
+    pub fn check_submission(&self, bundle_path: &Path) -> Result<(), HostError> {
+        let c = &self.common;
+        let scene = read_scene(c.scene.as_deref())?;
+        let lines = c
+            .line
+            .iter()
+            .map(|spec| LineKey::parse(spec))
+            .collect::<Result<Vec<_>, _>>()?;
+        let frames = self.frames(scene.as_ref(), &lines)?;
+        self.check_outputs(&frames)?;
+        let params = c
+            .param
+            .iter()
+            .map(|spec| ParamSetting::parse(spec))
+            .collect::<Result<Vec<_>, _>>()?;
+        let bundle = Bundle::load(bundle_path)?;
+        let inst = bundle.instance(self.plugin, self.context)?;
+        for p in &params {
+            p.apply(&inst)?;
+        }
+        Ok(())
     }
 
     pub fn run(&self, bundle_path: &Path) -> Result<(), HostError> {
@@ -315,7 +365,7 @@ impl Job {
                     size: inputs.size,
                     origin: inputs.windows.get(&f).map_or((0, 0), |w| w.origin),
                 };
-                writer.write(frame_path(pattern, f), plate, format)?;
+                writer.write(frame_path(pattern, f), plate, format_for(view, format))?;
             }
             if purge {
                 inst.purge_caches()?;
@@ -337,6 +387,20 @@ impl Job {
             writing.as_secs_f64()
         ));
         Ok(())
+    }
+}
+
+/// How `view` is written: ST maps always as 32-bit float (Nuke's STMap
+/// convention, and half floats are 0.94 px off at 1920 px wide), the rest
+/// as the run's format says.
+fn format_for(view: &str, format: io::OutputFormat) -> io::OutputFormat {
+    if view.starts_with("stmap") {
+        io::OutputFormat {
+            precision: ExrPrecision::Float,
+            ..format
+        }
+    } else {
+        format
     }
 }
 

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::host::HostError;
-use crate::sequence::parse_frames;
+use crate::sequence::{openjd_frames, parse_frames};
 use crate::snap::write_atomically;
 
 const MORPH_TEMPLATE: &str = include_str!("../../../farm/openjd/morph.template.yaml");
@@ -34,9 +34,15 @@ pub struct Job<'a> {
 /// Each job parameter's name and value (a string or an integer).
 type Values = Vec<(&'static str, Value)>;
 
-/// Writes the job bundle for `job.command` into `job.dir`.
-pub fn write_bundle(job: &Job) -> Result<(), HostError> {
+/// Writes the job bundle for `job.command` into `job.dir`, once the
+/// command fits the template and `check` (what a worker would check first)
+/// passes: a job that cannot run leaves nothing written.
+pub fn write_bundle(
+    job: &Job,
+    check: impl FnOnce() -> Result<(), HostError>,
+) -> Result<(), HostError> {
     let (template, values) = job_values(job)?;
+    check()?;
     let mut deadline = String::from("parameterValues:\n");
     for (name, value) in &values {
         // A JSON scalar is a YAML one (strings double-quoted).
@@ -104,12 +110,13 @@ fn job_values(job: &Job) -> Result<(&'static str, Values), HostError> {
     }
     let frames = options.value("--frames")?;
     parse_frames(frames)?;
+    let frames = openjd_frames(frames);
     values.extend([
         (
             "Output",
             Value::from(absolute(Path::new(options.value("-o")?))?),
         ),
-        ("Frames", Value::from(frames.to_owned())),
+        ("Frames", Value::from(frames)),
         ("ChunkSize", Value::from(job.chunk_size)),
         ("ChunkTargetRuntime", Value::from(job.chunk_target_runtime)),
         ("ExtraArgs", Value::from(options.extra(inputs)?)),
