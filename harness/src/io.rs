@@ -83,6 +83,8 @@ pub struct Header {
     pub window: DisplayWindow,
     /// Every channel is half float (an EXR written at half precision).
     pub half: bool,
+    /// The file has an alpha channel (without one, alpha reads as 1).
+    pub alpha: bool,
     /// How an EXR's pixels are compressed (`None`: not an EXR).
     pub compression: Option<Compression>,
 }
@@ -153,9 +155,19 @@ fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if !is_exr {
-        let (w, h) = ::image::image_dimensions(path)
-            .map_err(|e| HostError::bad(format!("{}: cannot read image: {e}", path.display())))?;
+        use ::image::ImageDecoder;
+        let cannot = |e: &dyn std::fmt::Display| {
+            HostError::bad(format!("{}: cannot read image: {e}", path.display()))
+        };
+        let decoder = ::image::ImageReader::open(path)
+            .map_err(|e| cannot(&e))?
+            .with_guessed_format()
+            .map_err(|e| cannot(&e))?
+            .into_decoder()
+            .map_err(|e| cannot(&e))?;
+        let (w, h) = decoder.dimensions();
         let (w, h) = (w as usize, h as usize);
+        let alpha = decoder.color_type().has_alpha();
         let window = DisplayWindow {
             size: (w, h),
             origin: (0, 0),
@@ -164,6 +176,7 @@ fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
             bounds: RectI::from_size(w, h),
             window,
             half: false,
+            alpha,
             compression: None,
         });
     }
@@ -184,10 +197,12 @@ fn probe_unchecked(path: &Path) -> std::result::Result<Header, HostError> {
         .list
         .iter()
         .all(|c| c.sample_type == exr::meta::attribute::SampleType::F16);
+    let alpha = header.channels.list.iter().any(|c| is_alpha(&c.name));
     Ok(Header {
         bounds: data_bounds(display, pos, (w, h)),
         window,
         half,
+        alpha,
         compression: Some(header.compression),
     })
 }
@@ -294,6 +309,16 @@ fn read_exr_meta(path: &Path) -> std::result::Result<exr::meta::MetaData, HostEr
     Ok(meta)
 }
 
+/// Whether EXR channel `name` is `what` (`R`, `alpha`, ...), alone or as
+/// the last part of a layer's name (`beauty.A`).
+fn channel_is(name: &exr::meta::attribute::Text, what: &str) -> bool {
+    name.eq_case_insensitive(what) || name.to_string().ends_with(&format!(".{what}"))
+}
+
+fn is_alpha(name: &exr::meta::attribute::Text) -> bool {
+    channel_is(name, "A") || channel_is(name, "alpha")
+}
+
 /// An EXR data window in canonical pixels: EXR y grows downwards, canonical y
 /// upwards from the display window's bottom.
 fn data_bounds(
@@ -350,11 +375,11 @@ fn read_exr(path: &Path) -> std::result::Result<Plate, HostError> {
     let (w, h) = (layer.size.width(), layer.size.height());
     let pos = layer.attributes.layer_position;
     let find = |names: &[&str]| {
-        layer.channel_data.list.iter().position(|c| {
-            names.iter().any(|n| {
-                c.name.eq_case_insensitive(n) || c.name.to_string().ends_with(&format!(".{n}"))
-            })
-        })
+        layer
+            .channel_data
+            .list
+            .iter()
+            .position(|c| names.iter().any(|n| channel_is(&c.name, n)))
     };
     let (r, g, b, a, y) = (
         find(&["R", "red"]),

@@ -313,3 +313,160 @@ fn keyed_params_interpolate_and_params_lists_every_id() {
     let (code, _) = morphfx(&["params", "--node", "blur"]);
     assert_eq!(code, 2);
 }
+
+/// A matte with no alpha (an RGB PNG, a one-channel grey PNG) acts by the
+/// mean of its R, G and B, as the nodes read an RGB matte: not as alpha 1
+/// everywhere. Each is compared with the same values given as alpha.
+#[test]
+fn mattes_without_alpha_act_by_their_mean() {
+    let d = common::scratch("mask-rgb");
+    let a = plate(&d, "a.exr", 0.0);
+    let b = plate(&d, "b.exr", 1.7);
+    let (w, h) = (W as u32, H as u32);
+    // Left to right 0 → 1 in code values; R, G, B differ, their mean ramps.
+    let level = |x: u32| (x * 255 / (w - 1)) as u8;
+    let rgb = ::image::RgbImage::from_fn(w, h, |x, _| {
+        let v = level(x);
+        ::image::Rgb([v, v / 2, v.saturating_add(v / 2).min(255)])
+    });
+    rgb.save(d.join("rgb.png")).unwrap();
+    let grey = ::image::GrayImage::from_fn(w, h, |x, _| ::image::Luma([level(x)]));
+    grey.save(d.join("grey.png")).unwrap();
+    // The same mattes as alpha, for the expected pictures.
+    let as_alpha = |name: &str, m: &dyn Fn(u32) -> f32| {
+        let img = ::image::RgbaImage::from_fn(w, h, |x, _| {
+            ::image::Rgba([255, 255, 255, (m(x) * 255.0).round() as u8])
+        });
+        img.save(d.join(name)).unwrap();
+    };
+    let mean = |x: u32| {
+        let v = level(x) as f32;
+        (v + (level(x) / 2) as f32 + (level(x).saturating_add(level(x) / 2)).min(255) as f32)
+            / (3.0 * 255.0)
+    };
+    as_alpha("rgb-alpha.png", &mean);
+    as_alpha("grey-alpha.png", &|x| level(x) as f32 / 255.0);
+    for (matte, like) in [("rgb.png", "rgb-alpha.png"), ("grey.png", "grey-alpha.png")] {
+        for role in ["--mask", "--timing"] {
+            let render = |m: &str, out: &str| {
+                let out = d.join(out);
+                ok(&[
+                    "morph",
+                    "--line",
+                    LINE,
+                    "--a",
+                    s(&a),
+                    "--b",
+                    s(&b),
+                    "--t",
+                    "0.5",
+                    role,
+                    s(&d.join(m)),
+                    "--raw",
+                    "-o",
+                    s(&out),
+                ]);
+                read(&out, Colour::Raw)
+            };
+            let got = render(matte, "got.exr");
+            let want = render(like, "want.exr");
+            let plain = render_without(&d, &a, &b);
+            let worst = got
+                .data
+                .iter()
+                .zip(&want.data)
+                .map(|(g, w)| (g - w).abs())
+                .fold(0f32, f32::max);
+            // 8-bit alpha rounds the mean to 1/510.
+            assert!(worst < 0.01, "{matte} {role}: {worst} from the alpha matte");
+            assert_ne!(
+                got.data, plain.data,
+                "{matte} {role}: the matte was ignored"
+            );
+        }
+    }
+}
+
+/// The morph at t = 0.5 with no matte.
+fn render_without(d: &Path, a: &Path, b: &Path) -> Image {
+    let out = d.join("plain.exr");
+    ok(&[
+        "morph",
+        "--line",
+        LINE,
+        "--a",
+        s(a),
+        "--b",
+        s(b),
+        "--t",
+        "0.5",
+        "-o",
+        s(&out),
+    ]);
+    read(&out, Colour::Raw)
+}
+
+/// A timing matte keeps opaque plates opaque (its weights on A and B sum
+/// to 1 however the warps disagree), and where it holds A, the picture is
+/// warped A up to the frame's edges: no sliver of B, no seam.
+#[test]
+fn a_timing_matte_keeps_plates_opaque_and_holds_a_to_the_edge() {
+    let d = common::scratch("timing-edges");
+    let a = plate(&d, "a.exr", 0.0);
+    let b = plate(&d, "b.exr", 1.7);
+    // Alpha 1 (A's turn last) left of x = 40, a ramp down to 0 at the right.
+    let matte = Image::from_fn(RectI::from_size(W, H), 4, |i, _, c| match c {
+        3 if i < 40 => 1.0,
+        3 => 1.0 - (i - 40) as f32 / 40.0,
+        _ => 1.0,
+    });
+    let m = d.join("timing.exr");
+    io::write(&m, &Plate::new(matte, (W, H)), ExrPrecision::Float).unwrap();
+    for t in ["0.3", "0.5"] {
+        let render = |view: &str| {
+            let out = d.join(format!("{view}.exr"));
+            ok(&[
+                "morph",
+                "--line",
+                LINE,
+                "--a",
+                s(&a),
+                "--b",
+                s(&b),
+                "--t",
+                t,
+                "--timing",
+                s(&m),
+                "--view",
+                view,
+                "-o",
+                s(&out),
+            ]);
+            read(&out, Colour::Raw)
+        };
+        let (got, warped_a) = (render("morph"), render("warped-a"));
+        for j in 0..H as i32 {
+            for i in 0..W as i32 {
+                let px = got.pixel(i, j);
+                assert!(
+                    (px[3] - 1.0).abs() < 1e-5,
+                    "t {t} ({i}, {j}): alpha {}",
+                    px[3]
+                );
+                // Spread 0.5: where g = 1 the colour's rate is 0 until
+                // t = 0.5, so the dissolve shows warped A alone (B differs
+                // from A by up to 0.8 there).
+                if i < 30 {
+                    for c in 0..3 {
+                        let want = warped_a.pixel(i, j)[c];
+                        assert!(
+                            (px[c] - want).abs() < 1e-4,
+                            "t {t} ({i}, {j}) {c}: {} where the matte holds A ({want})",
+                            px[c]
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

@@ -55,16 +55,19 @@ impl Matte {
         })
     }
 
-    /// `g(p)`: the alpha at canonical `p`, bilinear between pixel centres
-    /// (held at the edge pixels' values up to the window's edge), 0 outside
-    /// the window.
+    /// `g(p)`: the alpha at canonical `p`, bilinear between pixel centres,
+    /// held at the edge pixels' values beyond them. Held, not 0, outside
+    /// the window: a warp near the frame's edge reads A from just outside
+    /// it, and a 0 there gave those pixels B's turn, a sliver of B along
+    /// an edge the matte holds on A. (A matte cropped to its bounding box
+    /// has edges of 0, and holds them.)
     pub fn order(&self, p: Vec2) -> f64 {
         let w = self.window;
         if w.is_empty() {
             return 0.0;
         }
         let q = self.scale.to_pixel(p);
-        if q.x < w.x1 as f64 || q.x >= w.x2 as f64 || q.y < w.y1 as f64 || q.y >= w.y2 as f64 {
+        if !(q.x.is_finite() && q.y.is_finite()) {
             return 0.0;
         }
         // Continuous pixel coordinates from the first pixel's centre.
@@ -123,11 +126,13 @@ mod tests {
         let g = m.order(Vec2::new(22.0, 12.0));
         let want = 0.5 * (0.0 + 0.25) / 2.0 + 0.5 * (0.1f32 as f64 + 0.2f32 as f64) / 2.0;
         assert!((g - want).abs() < 1e-12, "{g} vs {want}");
-        // Held at the edge pixel up to the window's edge, 0 past it.
+        // Held at the edge pixels, up to the window's edge and past it.
         assert_eq!(m.order(Vec2::new(20.2, 10.1)), 0.0);
         assert_eq!(m.order(Vec2::new(27.9, 11.0)), 1.0);
-        assert_eq!(m.order(Vec2::new(28.1, 11.0)), 0.0);
-        assert_eq!(m.order(Vec2::new(23.0, 9.9)), 0.0);
+        assert_eq!(m.order(Vec2::new(28.1, 11.0)), 1.0);
+        assert_eq!(m.order(Vec2::new(500.0, 11.0)), 1.0);
+        assert_eq!(m.order(Vec2::new(23.0, 9.9)), 0.25);
+        assert_eq!(m.order(Vec2::new(-1e9, 1e9)), 0.1f32 as f64);
     }
 
     #[test]

@@ -289,7 +289,11 @@ pub fn constraints(
 }
 
 /// Per-pixel weights of the dissolve (Lee, Wolberg et al. §3): A's colour attenuated by
-/// `1 − T0` at the point it comes from, B's by `T1 = T0 ∘ W1` at its point.
+/// `1 − T0` at the point it comes from, B's by `T1 = T0 ∘ W1` at its point,
+/// then scaled to sum to 1. The two points agree only where `W1` inverts the
+/// warps exactly; elsewhere (any field warp) the paper's weights sum to a
+/// little more or less than 1, which made opaque plates come out with
+/// alpha 0.98 and bright seams where the rate changes fast.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Weights {
     /// Output pixels covered.
@@ -330,13 +334,25 @@ pub fn colour_weights(rates: &Rates, map_a: &WarpMap, map_b: &WarpMap, w1: &dyn 
                         ys[k] = q.y as f32;
                     }
                     w1.map_points(xs, ys, ox, oy);
-                    for (k, o) in wb.iter_mut().enumerate() {
-                        *o = rates.at(Vec2::new(ox[k] as f64, oy[k] as f64)) as f32;
+                    for (k, (a, b)) in wa.iter_mut().zip(wb.iter_mut()).enumerate() {
+                        let tb = rates.at(Vec2::new(ox[k] as f64, oy[k] as f64)) as f32;
+                        (*a, *b) = normalised(*a, tb);
                     }
                 },
             );
     }
     Weights { window, a, b }
+}
+
+/// A's and B's weights scaled to sum to 1; where both are 0 (A's point
+/// has turned, B's not yet), an even mix.
+fn normalised(a: f32, b: f32) -> (f32, f32) {
+    let sum = a + b;
+    if sum > 0.0 {
+        (a / sum, b / sum)
+    } else {
+        (0.5, 0.5)
+    }
 }
 
 #[cfg(test)]

@@ -250,3 +250,31 @@ fn colour_weights_carry_t0_to_b_through_w1() {
     assert!((w.a[1] as f64 - (1.0 - mouth_rate)).abs() < 2e-3);
     assert!((w.b[1] as f64 - mouth_rate).abs() < 2e-3);
 }
+
+#[test]
+fn colour_weights_sum_to_one_where_the_two_points_disagree() {
+    // A pixel whose A point is the eye (rate 0.1) but whose B point is
+    // the mouth's (rate C(t) of the mouth curve): the paper's weights,
+    // 1 − 0.1 and C(t), sum to more than 1; the dissolve keeps their ratio
+    // and sums to 1, so opaque plates stay opaque.
+    let fs = features();
+    let transition = TransitionSettings {
+        geometry: Transition::Uniform,
+        colour: Some(curves(Propagation::default())),
+    };
+    let s = settings(Method::Triangles, transition);
+    let t = 0.5;
+    let rates = s.colour_rates(&fs, t).unwrap();
+    let w1 = make_warp::toward(&fs, Side::A, 1.0, &s).unwrap();
+    let window = RectI::new(0, 0, 1, 1);
+    let scale = PixelScale::new(1.0, 1.0, 1.0);
+    let at = |v: Vec2| vec![[v.x as f32, v.y as f32]];
+    let map_a = crate::image::WarpMap::new(window, scale, at(fs[1].a[0]));
+    let map_b = crate::image::WarpMap::new(window, scale, at(fs[0].b[1]));
+    let w = colour_weights(&rates, &map_a, &map_b, w1.as_ref());
+    let mouth_rate = Curve::new(&[(0.3, 0.8), (0.6, 0.9)], "m").unwrap().at(t);
+    let (pa, pb) = (1.0 - 0.1, mouth_rate);
+    assert!(pa + pb > 1.5, "the paper's weights sum to {}", pa + pb);
+    assert!((w.a[0] + w.b[0] - 1.0).abs() < 1e-6, "{:?} {:?}", w.a, w.b);
+    assert!((w.a[0] as f64 / w.b[0] as f64 - pa / pb).abs() < 1e-2);
+}

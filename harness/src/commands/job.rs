@@ -144,7 +144,7 @@ impl Job {
         let mattes: Vec<(String, Arc<Plates>)> = self
             .mattes
             .iter()
-            .map(|(clip, p)| (clip.clone(), Plates::new(p, c.colour())))
+            .map(|(clip, p)| (clip.clone(), Plates::matte(p, c.colour())))
             .collect();
         check_mattes(&mattes, &frames)?;
         let params = c

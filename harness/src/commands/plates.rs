@@ -4,7 +4,7 @@
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use crate::host::{Frame, FrameSource, HostError};
+use crate::host::{frame, Frame, FrameSource, HostError};
 use crate::io::{self};
 use crate::pipeline::ReadAhead;
 use crate::sequence::{frame_path, is_sequence};
@@ -24,6 +24,9 @@ pub struct Plates {
     /// The first read that failed: the plugin only learns "no image", so the
     /// harness reports the file and why itself.
     pub error: Mutex<Option<HostError>>,
+    /// A matte (Mask, Timing): a file with no alpha is handed over as RGB,
+    /// which the nodes read by its mean, not as RGBA with alpha 1.
+    pub matte: bool,
 }
 
 /// A plate as the host hands it over, with its display window's size.
@@ -38,7 +41,15 @@ impl Plates {
             ahead: Mutex::new(ReadAhead::default()),
             read_time: Mutex::new(Duration::ZERO),
             error: Mutex::new(None),
+            matte: false,
         })
+    }
+
+    /// A matte's frames: see [`Plates::matte`](field@Plates::matte).
+    pub fn matte(pattern: &str, colour: io::Colour) -> Arc<Plates> {
+        let mut plates = Arc::into_inner(Plates::new(pattern, colour)).expect("just made");
+        plates.matte = true;
+        Arc::new(plates)
     }
 
     pub fn file_frame(&self, frame: i64) -> i64 {
@@ -53,9 +64,13 @@ impl Plates {
         let path = frame_path(&self.pattern, frame);
         let started = Instant::now();
         let plate = io::read_as(&path, self.colour)?;
+        let image = if self.matte && !io::probe(&path)?.alpha {
+            frame::with_channels(&plate.image, 3)
+        } else {
+            plate.image
+        };
         *self.read_time.lock().unwrap_or_else(|e| e.into_inner()) += started.elapsed();
-        let size = plate.size;
-        Ok((Arc::new(Frame::from_float_image(plate.image)), size))
+        Ok((Arc::new(Frame::from_float_image(image)), plate.size))
     }
 
     /// Starts reading `frame` on another thread, unless it is at hand.

@@ -73,8 +73,11 @@ pub const VERSION: (u32, u32) = (1, 0);
 /// The pixel layouts every clip takes.
 const COMPONENTS: &[Components] = &[Components::Rgba, Components::Rgb, Components::Alpha];
 
-/// The layouts the mask and timing clips take: their alpha is what counts.
-const MATTE_COMPONENTS: &[Components] = &[Components::Alpha, Components::Rgba];
+/// The layouts the mask and timing clips take: their alpha is what counts,
+/// and a matte with no alpha (a grey or RGB render) counts by the mean of
+/// its R, G and B, so a host hands it over as RGB rather than with an
+/// alpha of 1 filled in.
+const MATTE_COMPONENTS: &[Components] = &[Components::Alpha, Components::Rgba, Components::Rgb];
 
 /// The optional mask input of both nodes: where the effect applies.
 pub const MASK_CLIP: &str = "Mask";
@@ -119,8 +122,8 @@ impl<N: Node> ImageEffect for N {
             mask: false,
         };
         let mut clips: Vec<ClipSpec> = std::iter::once(a).chain(b).map(source).collect();
-        // Mattes: alpha is what is read (an RGB matte's mean where a host
-        // sends one anyway); the timing matte may be read anywhere on A.
+        // Mattes: alpha is what is read (an RGB matte's mean); the timing
+        // matte may be read anywhere on A.
         let matte = |name, mask| ClipSpec {
             name,
             components: MATTE_COMPONENTS,
