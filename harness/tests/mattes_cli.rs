@@ -470,3 +470,66 @@ fn a_timing_matte_keeps_plates_opaque_and_holds_a_to_the_edge() {
         }
     }
 }
+
+/// `--param` has the last word: a setting the scene's own would silently
+/// replace (Settings From Scene on) is refused, naming the way out; with
+/// `settings_from_scene=false` it is honoured; a param the scene does not
+/// set is honoured as it is.
+#[test]
+fn params_the_scene_overrides_are_refused_or_honoured_never_ignored() {
+    let d = common::scratch("param-scene");
+    let a = plate(&d, "a.exr", 0.0);
+    let scene = d.join("s.morph.json");
+    std::fs::write(
+        &scene,
+        r#"{"format": "morphfx-scene", "version": 1, "method": "field",
+            "field": {"a": 0.001, "b": 2, "p": 0.5, "evaluation": "exact"},
+            "features": [{"type": "line", "a": [[10, 10], [60, 14]], "b": [[18, 6], [66, 22]]}]}"#,
+    )
+    .unwrap();
+    let warp = |params: &[&str], out: &str| {
+        let mut args = vec!["warp", "--scene", s(&scene), "--input", s(&a), "--t", "1"];
+        args.extend(params);
+        let out = d.join(out);
+        args.extend(["-o", s(&out)]);
+        let r = morphfx(&args);
+        (r, out)
+    };
+    for refused in [
+        "method=mesh",
+        "field_b=0.5",
+        "line_interpolation=center-angle",
+        "evaluation=adaptive",
+        "mesh_pass=one-pass",
+        "auto_levels=3",
+        "plate_alpha=10",
+    ] {
+        let ((code, err), out) = warp(&["--param", refused], "refused.exr");
+        assert_eq!(code, 2, "{refused}: {err}");
+        assert!(
+            err.contains("settings_from_scene") && err.contains(refused),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+    let ((code, err), scene_own) = warp(&[], "scene.exr");
+    assert_eq!(code, 0, "{err}");
+    let ((code, err), node_own) = warp(
+        &[
+            "--param",
+            "settings_from_scene=false",
+            "--param",
+            "field_b=0.5",
+        ],
+        "node.exr",
+    );
+    assert_eq!(code, 0, "{err}");
+    let ((code, err), mixed) = warp(&["--param", "mix=0.5"], "mix.exr");
+    assert_eq!(code, 0, "{err}");
+    let [scene_own, node_own, mixed] = [scene_own, node_own, mixed].map(|p| read(&p, Colour::Raw));
+    assert_ne!(
+        scene_own.data, node_own.data,
+        "field_b=0.5 was not honoured"
+    );
+    assert_ne!(scene_own.data, mixed.data, "mix=0.5 was not honoured");
+}

@@ -209,6 +209,9 @@ impl Job {
         for p in &params {
             p.apply(&inst)?;
         }
+        if let Some(scene) = &scene {
+            refuse_settings_the_scene_sets(&inst, scene, &params)?;
+        }
         Ok(())
     }
 
@@ -267,6 +270,9 @@ impl Job {
         }
         for p in &job.params {
             p.apply(inst)?;
+        }
+        if let Some(scene) = &job.scene {
+            refuse_settings_the_scene_sets(inst, scene, &job.params)?;
         }
         inst.set_project(size.0 as f64, size.1 as f64);
         for (clip, p) in job.plates.iter().chain(&job.mattes) {
@@ -388,6 +394,47 @@ impl Job {
         ));
         Ok(())
     }
+}
+
+/// The param groups whose values a scene's settings replace while
+/// *Settings From Scene* is on (the node's default): the method's own.
+const SCENE_GROUPS: [&str; 4] = ["field_group", "mesh_group", "auto_group", "scattered_group"];
+
+/// `--param` has the last word, so one the scene would silently override
+/// is refused rather than ignored: the method and its settings, and the
+/// transition's when the scene has one (its spread still paces a timing
+/// matte, so it is not among them).
+fn refuse_settings_the_scene_sets(
+    inst: &Instance<'_>,
+    scene: &Scene,
+    params: &[ParamSetting],
+) -> Result<(), HostError> {
+    let node_wins = params
+        .iter()
+        .any(|p| p.id == "settings_from_scene" && p.value.trim() == "false");
+    if node_wins {
+        return Ok(());
+    }
+    let scene_transition = scene.settings.transition != Default::default();
+    for p in params {
+        let group = inst
+            .param_props(&p.id)
+            .and_then(|props| props.str(openfx::sys::image_effect_v1::param::kOfxParamPropParent))
+            .unwrap_or_default();
+        let overridden = p.id == "method"
+            || SCENE_GROUPS.contains(&group.as_str())
+            || (group == "transition_group" && p.id != "transition_spread" && scene_transition);
+        if overridden {
+            return Err(HostError::bad(format!(
+                "--param {}={}: the scene sets this (settings_from_scene is on, so its method \
+                 settings win over the node's): add --param settings_from_scene=false to use \
+                 the node's settings (the scene then gives its features, mesh and progress), or \
+                 set it in the scene",
+                p.id, p.value
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// How `view` is written: ST maps always as 32-bit float (Nuke's STMap

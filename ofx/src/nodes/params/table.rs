@@ -65,7 +65,7 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
             Kind::Double { default: 0.5, min: 0.0, max: 1.0, display: (0.0, 1.0) },
         ),
         ParamSpec::new(USE_SCENE_PROGRESS, "Use Scene Progress", "When the scene keys progress, follow it instead of the Progress param.", Kind::Bool { default: true }),
-        ParamSpec::new(SETTINGS_FROM_SCENE, "Settings From Scene", "When a scene is loaded, its method and field settings win over this node's.", Kind::Bool { default: true }),
+        ParamSpec::new(SETTINGS_FROM_SCENE, "Settings From Scene", "When a scene is loaded, its method and that method's settings (field, mesh, auto, thin plate, MFFD, and its transition when it has one) win over this node's.", Kind::Bool { default: true }),
         ParamSpec::new("field_group", "Field", "Beier-Neely field constants", Kind::Group { open: true }),
         ParamSpec::new(FIELD_A, "a", "weight = (length^p / (a + dist))^b. Barely above 0 pins pixels on a line to it; larger is smoother.", Kind::Double { default: d.a, min: 1e-6, max: 1000.0, display: (0.0001, 10.0) }).in_group("field_group"),
         ParamSpec::new(FIELD_B, "b", "How fast a line's influence falls off with distance (0.5 to 2 is most useful).", Kind::Double { default: d.b, min: 0.0, max: 10.0, display: (0.0, 4.0) }).in_group("field_group"),
