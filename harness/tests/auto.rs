@@ -124,7 +124,7 @@ fn auto_needs_two_images() {
 }
 
 #[test]
-fn verbose_sequences_print_the_work_table_and_start_warm() {
+fn verbose_sequences_print_the_work_table_and_start_warm_when_asked() {
     let d = common::scratch("auto-seq");
     for f in [1, 2] {
         plate(&d.join(format!("a.{f:04}.exr")), |p| p);
@@ -132,7 +132,12 @@ fn verbose_sequences_print_the_work_table_and_start_warm() {
             h(p) + Vec2::new(0.3 * f as f64, 0.0)
         });
     }
-    std::fs::write(d.join("s.json"), SCENE).unwrap();
+    // Warm starts are off by default (chunks would differ): asked for here.
+    let warm = SCENE.replace(
+        r#""features""#,
+        r#""auto": {"warm_start": true}, "features""#,
+    );
+    std::fs::write(d.join("s.json"), warm).unwrap();
     let out = common::run_morphfx(&[
         "--verbose",
         "morph",

@@ -241,11 +241,12 @@ fn descriptors_say_how_to_render_them() {
 
 #[test]
 fn frames_render_the_same_in_any_order() {
-    // Thin plates warm-start from a neighbouring frame only in a sequential
-    // render; a host rendering frames in any order (farm chunks, threads)
-    // gets exactly the frame a fresh instance makes.
+    // Thin plates warm-start from a neighbouring frame only in a viewer's
+    // interactive render; a host rendering frames in any order (farm
+    // chunks, threads), in sequence or not, gets exactly the frame a fresh
+    // instance makes.
     let a = plate(96, 64, 0.0);
-    let render = |frames: &[f64]| {
+    let render = |frames: &[f64], sequential: bool| {
         let inst = bundle()
             .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
             .unwrap();
@@ -260,11 +261,21 @@ fn frames_render_the_same_in_any_order() {
         inst.set_double("progress", &[1.0], None).unwrap();
         let mut last = None;
         for &f in frames {
-            last = Some(inst.render(f, OWN_PIXELS).unwrap().to_image());
+            let spec = OutputSpec {
+                sequential,
+                ..OWN_PIXELS
+            };
+            last = Some(inst.render(f, spec).unwrap().to_image());
         }
         last.unwrap()
     };
-    assert_eq!(render(&[1.0, 2.0]).data, render(&[2.0]).data);
+    for sequential in [false, true] {
+        assert_eq!(
+            render(&[1.0, 2.0], sequential).data,
+            render(&[2.0], sequential).data,
+            "sequential: {sequential}"
+        );
+    }
 }
 
 #[test]
@@ -406,9 +417,10 @@ fn a_warm_started_thin_plate_matches_a_cold_one_at_another_scale() {
         inst.connect("Source", still(&a)).unwrap();
         let mut last = None;
         for &s in scales {
+            // A viewer's renders: the only ones thin plates warm-start in.
             let spec = OutputSpec {
                 render_scale: (s, s),
-                sequential: true,
+                interactive: true,
                 ..OWN_PIXELS
             };
             last = Some(inst.render(0.0, spec).unwrap().to_image());

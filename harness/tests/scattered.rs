@@ -188,8 +188,11 @@ fn plate_solves(err: &str) -> Vec<(i32, String, bool, usize)> {
 }
 
 #[test]
-fn thin_plates_start_from_the_previous_frame() {
-    let d = common::scratch("scattered-warm");
+fn thin_plates_solve_every_frame_cold_in_a_sequence_render() {
+    // A final render's frame depends on that frame alone: a sequence
+    // solves each frame's plates cold (warm starts are for the viewer), so
+    // a frame alone is the same bits as in the sequence.
+    let d = common::scratch("scattered-cold");
     for f in 1..=3 {
         plate(&d.join(format!("a.{f:04}.exr")), texture);
         plate(&d.join(format!("b.{f:04}.exr")), texture);
@@ -233,27 +236,11 @@ fn thin_plates_start_from_the_previous_frame() {
         .filter(|s| s.1 == "A")
         .collect();
     assert_eq!(solves.len(), 3, "{err}");
-    assert!(!solves[0].2 && solves[1].2 && solves[2].2, "{err}");
-    for later in &solves[1..] {
-        assert!(
-            later.3 < solves[0].3,
-            "warm {} vs cold {}: {err}",
-            later.3,
-            solves[0].3
-        );
-    }
-    // Started warm or cold, frame 2's plates are the same solution.
+    assert!(solves.iter().all(|s| !s.2), "a warm start: {err}");
     let err = render("2", "alone");
     assert!(plate_solves(&err).iter().all(|s| !s.2), "{err}");
-    let warm = io::read(&d.join("seq-st.0002.exr")).unwrap().image;
-    let cold = io::read(&d.join("alone-st.0002.exr")).unwrap().image;
-    for j in 0..H as i32 {
-        for i in 0..W as i32 {
-            for c in 0..2 {
-                let (w, k) = (warm.pixel(i, j)[c], cold.pixel(i, j)[c]);
-                // ST is normalised: 0.01 px of a 128 px wide plate.
-                assert!((w - k).abs() < 0.01 / W as f32, "({i}, {j}) {w} vs {k}");
-            }
-        }
+    for tag in ["", "-st"] {
+        let read = |run: &str| std::fs::read(d.join(format!("{run}{tag}.0002.exr"))).unwrap();
+        assert!(read("seq") == read("alone"), "frame 2{tag} differs alone");
     }
 }

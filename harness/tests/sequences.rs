@@ -91,6 +91,37 @@ fn assert_translation(path: &Path, shift: (f32, f32), tol: f32) {
     }
 }
 
+/// A keyed 3 × 3 mesh on the 48 × 32 plates: B's centre node moves.
+const KEYED_MESH: &str = r#"{"format": "morphfx-scene", "version": 1, "method": "mesh",
+  "mesh": {"rows": 3, "cols": 3, "keyframes": [
+    {"frame": 1001, "a": [[0,0],[24,0],[48,0],[0,16],[24,16],[48,16],[0,32],[24,32],[48,32]],
+                    "b": [[0,0],[24,0],[48,0],[0,16],[27,14],[48,16],[0,32],[24,32],[48,32]]},
+    {"frame": 1004, "a": [[0,0],[24,0],[48,0],[0,16],[24,16],[48,16],[0,32],[24,32],[48,32]],
+                    "b": [[0,0],[24,0],[48,0],[0,16],[21,19],[48,16],[0,32],[24,32],[48,32]]}]}}"#;
+
+/// Every method's keyed scene over frames 1001–1004, progress keyed too.
+fn every_method_scene() -> Vec<(&'static str, String)> {
+    let progress = r#""progress": [[1001, 0.0], [1004, 1.0]], "keyframes""#;
+    let mut scenes: Vec<(&str, String)> =
+        ["field", "triangles", "thin-plate", "mffd", "hybrid", "auto"]
+            .into_iter()
+            .map(|m| {
+                let scene = KEYED
+                    .replace(r#""keyframes""#, progress)
+                    .replace(r#""method": "field""#, &format!(r#""method": "{m}""#));
+                (m, scene)
+            })
+            .collect();
+    scenes.push((
+        "mesh",
+        KEYED_MESH.replace(
+            r#""mesh": {"#,
+            r#""progress": [[1001, 0.0], [1004, 1.0]], "mesh": {"#,
+        ),
+    ));
+    scenes
+}
+
 #[test]
 fn a_sequence_render_equals_single_frame_renders_whatever_the_chunking() {
     let d = tmp("chunks");
@@ -110,61 +141,69 @@ fn a_sequence_render_equals_single_frame_renders_whatever_the_chunking() {
             ExrPrecision::Float,
         );
     }
-    let scene = KEYED.replace(
-        r#""keyframes""#,
-        r#""progress": [[1001, 0.0], [1004, 1.0]], "keyframes""#,
-    );
-    std::fs::write(d.join("s.morph.json"), scene).unwrap();
-    let render = |frames: &str, out: &str| {
-        morphfx(&[
-            "morph",
-            "--scene",
-            s(&d.join("s.morph.json")),
-            "--a",
-            s(&d.join("a.####.exr")),
-            "--b",
-            s(&d.join("b.####.exr")),
-            "--frames",
-            frames,
-            "-o",
-            s(&d.join(out)),
-        ])
-    };
-    render("1001-1004", "whole.####.exr");
-    render("1001-1002", "chunk.####.exr");
-    render("1003-1004", "chunk.####.exr");
-    for f in 1001..=1004 {
-        render(&f.to_string(), "single.####.exr");
-    }
-    for f in 1001..=1004 {
-        let whole = io::read(&d.join(format!("whole.{f}.exr"))).unwrap().image;
-        for other in ["chunk", "single"] {
-            let o = io::read(&d.join(format!("{other}.{f}.exr"))).unwrap().image;
-            assert_eq!(
-                whole, o,
-                "frame {f}: {other} differs from the sequence render"
-            );
-        }
-    }
-    // Farms' stepped ranges and lists render exactly the frames they name,
-    // each as the sequence render made it.
-    render("1001-1004x3", "stepped.####.exr");
-    render("1001-1004:2,1004", "colon.####.exr");
-    for (out, frames) in [("stepped", [1001, 1004]), ("colon", [1001, 1003])] {
+    // Every method: warm starts and caches must not carry one frame's
+    // solve into the next in a way a chunk starting there could not.
+    for (method, scene) in every_method_scene() {
+        let scene_path = d.join(format!("{method}.morph.json"));
+        std::fs::write(&scene_path, scene).unwrap();
+        let render = |frames: &str, out: &str| {
+            morphfx(&[
+                "morph",
+                "--scene",
+                s(&scene_path),
+                "--a",
+                s(&d.join("a.####.exr")),
+                "--b",
+                s(&d.join("b.####.exr")),
+                "--frames",
+                frames,
+                "-o",
+                s(&d.join(format!("{method}-{out}"))),
+            ])
+        };
+        render("1001-1004", "whole.####.exr");
+        render("1001-1002", "chunk.####.exr");
+        render("1003-1004", "chunk.####.exr");
         for f in 1001..=1004 {
-            let path = d.join(format!("{out}.{f}.exr"));
-            let named = frames.contains(&f) || (out == "colon" && f == 1004);
-            assert_eq!(path.exists(), named, "{out}: frame {f}");
-            if named {
-                let whole = io::read(&d.join(format!("whole.{f}.exr"))).unwrap().image;
-                assert_eq!(io::read(&path).unwrap().image, whole, "{out}: frame {f}");
+            render(&f.to_string(), "single.####.exr");
+        }
+        let read = |name: String| std::fs::read(d.join(name)).unwrap();
+        for f in 1001..=1004 {
+            let whole = read(format!("{method}-whole.{f}.exr"));
+            for other in ["chunk", "single"] {
+                assert!(
+                    whole == read(format!("{method}-{other}.{f}.exr")),
+                    "{method}, frame {f}: {other} differs from the sequence render"
+                );
+            }
+        }
+        // The in-between frames really are in between (not a copy of A).
+        let mid = io::read(&d.join(format!("{method}-whole.1002.exr")))
+            .unwrap()
+            .image;
+        let a = io::read(&d.join("a.1002.exr")).unwrap().image;
+        assert_ne!(mid, a, "{method}");
+        if method != "field" {
+            continue;
+        }
+        // Farms' stepped ranges and lists render exactly the frames they
+        // name, each as the sequence render made it.
+        render("1001-1004x3", "stepped.####.exr");
+        render("1001-1004:2,1004", "colon.####.exr");
+        for (out, frames) in [("stepped", [1001, 1004]), ("colon", [1001, 1003])] {
+            for f in 1001..=1004 {
+                let path = d.join(format!("field-{out}.{f}.exr"));
+                let named = frames.contains(&f) || (out == "colon" && f == 1004);
+                assert_eq!(path.exists(), named, "{out}: frame {f}");
+                if named {
+                    assert!(
+                        read(format!("field-whole.{f}.exr")) == std::fs::read(&path).unwrap(),
+                        "{out}: frame {f}"
+                    );
+                }
             }
         }
     }
-    // The in-between frames really are in between (not a copy of A or B).
-    let mid = io::read(&d.join("whole.1002.exr")).unwrap().image;
-    let a = io::read(&d.join("a.1002.exr")).unwrap().image;
-    assert_ne!(mid, a);
 }
 
 /// `morphfx morph` of `src` with itself at `t` through `scene` into `out`,

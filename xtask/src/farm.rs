@@ -59,6 +59,21 @@ pub fn check(morphfx: &Path, bundle: &Path) {
         chunks += count_chunks(&out);
         same_frames(&single, &farm, node);
     }
+    // Every method: a warm start or cache that carried one frame's solve
+    // into the next would make a chunk's first frame differ.
+    for method in METHODS {
+        let shot = shot.with_method(method, &dir);
+        let single = dir.join(format!("{method}-single"));
+        shot.single("morph", &single);
+        let farm = dir.join(format!("{method}-farm"));
+        let mut params = shot.params(folder, &farm);
+        params.extend([("A", shot.a.clone()), ("B", shot.b.clone())]);
+        let template = templates.join("morph.template.yaml");
+        let out = openjd_run(&openjd, &template, &params);
+        expect_ok(&out, &format!("openjd run morph, method {method}"));
+        chunks += count_chunks(&out);
+        same_frames(&single, &farm, method);
+    }
     chunks += job_bundle(&openjd, &shot, &dir);
     refusals(
         &openjd,
@@ -69,10 +84,12 @@ pub fn check(morphfx: &Path, bundle: &Path) {
     );
     println!(
         "farm check (Open Job Description {}): both templates valid; a {FRAMES} shot in \
-         chunks of {CHUNK} ({chunks} chunks: morph, warp, and a `morphfx job openjd` bundle \
-         with an extra option) equals one morphfx call byte for byte; a failing chunk and a \
+         chunks of {CHUNK} ({chunks} chunks: morph, warp, morph by each of the {} methods, \
+         and a `morphfx job openjd` bundle with an extra option) equals one morphfx call \
+         byte for byte; a failing chunk and a \
          bad ChunkSize fail the run",
-        OPENJD[0]
+        OPENJD[0],
+        METHODS.len()
     );
 }
 
@@ -152,8 +169,21 @@ fn refusals(openjd: &Path, template: &Path, shot: &Shot, folder: &Path, dir: &Pa
     }
 }
 
+/// The methods besides `field` (the bench scene's own), each run on the
+/// farm too.
+const METHODS: [&str; 6] = ["mesh", "triangles", "thin-plate", "mffd", "hybrid", "auto"];
+
+/// A 3 × 3 mesh on the 96 × 64 shot, keyed at its first and last frame:
+/// B's centre node moves.
+const MESH: &str = r#""mesh": {"rows": 3, "cols": 3, "keyframes": [
+  {"frame": 1, "a": [[0,0],[48,0],[96,0],[0,32],[48,32],[96,32],[0,64],[48,64],[96,64]],
+               "b": [[0,0],[48,0],[96,0],[0,32],[53,29],[96,32],[0,64],[48,64],[96,64]]},
+  {"frame": 12, "a": [[0,0],[48,0],[96,0],[0,32],[48,32],[96,32],[0,64],[48,64],[96,64]],
+                "b": [[0,0],[48,0],[96,0],[0,32],[42,37],[96,32],[0,64],[48,64],[96,64]]}]}"#;
+
 /// The shot both runs render: plate sequences A and B and a keyframed
 /// scene, made by `morphfx bench` at a small size.
+#[derive(Clone)]
 struct Shot {
     morphfx: PathBuf,
     bundle: PathBuf,
@@ -181,6 +211,27 @@ impl Shot {
             scene: dir.join("shot").join("bench.morph.json"),
             a: plates.join("a.####.exr"),
             b: plates.join("b.####.exr"),
+        }
+    }
+
+    /// The shot with its scene rendered by `method` (a mesh added for
+    /// `mesh`), written into `dir`.
+    fn with_method(&self, method: &str, dir: &Path) -> Shot {
+        let text = std::fs::read_to_string(&self.scene).expect("the bench scene");
+        let field = r#""method":"field""#;
+        if !text.contains(field) {
+            eprintln!("farm check FAILED: the bench scene names no field method: {text}");
+            exit(1);
+        }
+        let with = match method {
+            "mesh" => format!(r#""method":"mesh",{MESH}"#),
+            other => format!(r#""method":"{other}""#),
+        };
+        let scene = dir.join(format!("{method}.morph.json"));
+        std::fs::write(&scene, text.replace(field, &with)).expect("write a scene");
+        Shot {
+            scene,
+            ..self.clone()
         }
     }
 

@@ -33,7 +33,10 @@ pub struct AutoSettings {
     pub levels: Option<u32>,
     /// The work's weights.
     pub coefficients: Coefficients,
-    /// Start each frame of a sequence from the previous frame's warp.
+    /// Start each frame of a sequence from the previous frame's warp:
+    /// faster, but a frame then depends on where its sequence started (a
+    /// farm's chunks differ from one run at their first frames), so off by
+    /// default.
     pub warm_start: bool,
     /// Refinements per point at the finest level when warm-starting.
     pub warm_iterations: usize,
@@ -47,7 +50,7 @@ impl Default for AutoSettings {
         AutoSettings {
             levels: None,
             coefficients: Coefficients::default(),
-            warm_start: true,
+            warm_start: false,
             warm_iterations: 3,
             initial: None,
         }

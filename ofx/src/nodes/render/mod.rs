@@ -399,7 +399,7 @@ fn map(
     }
     instance.warps.get_or_compute(key, || {
         let w: Arc<dyn Warp> = if inputs.warp.method() == Method::ThinPlate {
-            let when = (request.time, request.sequential);
+            let when = (request.time, request.interactive);
             Arc::new(warm::thin_plate(instance, inputs, side, when)?)
         } else {
             make_warp::toward(&inputs.features, side, inputs.t, &inputs.warp)?

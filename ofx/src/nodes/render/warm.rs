@@ -1,5 +1,8 @@
-//! Solves that start from this instance's earlier ones: `auto`
-//! correspondences and thin plates, warm-started only in sequential renders.
+//! Solves that start from this instance's earlier ones: thin plates in a
+//! viewer's interactive renders, and `auto` correspondences in sequential
+//! renders when *Warm Start* asks for it. Every other render solves cold,
+//! so a frame's pixels depend on that frame alone: a farm's chunks render
+//! what one call over the whole range renders, bit for bit.
 
 use std::sync::Arc;
 
@@ -39,8 +42,9 @@ pub(super) fn correspondence(
     ));
     let key = Key::of(&(&same_setup, a.digest(), b.digest(), &inputs.features));
     instance.correspondences.get_or_compute(key, || {
-        // Warm starts only in a sequential render: otherwise the result
-        // would depend on which frames this instance happened to render.
+        // Warm starts only in a sequential render, and only when asked for
+        // (off by default): the result then depends on where the sequence
+        // started, so a farm's chunks differ from one call at their starts.
         let warm = sequential
             .then(|| {
                 let grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
@@ -88,19 +92,20 @@ pub(super) fn correspondence(
     })
 }
 
-/// The frame's thin plates on `side`, solved from the plates this instance
-/// solved nearest in time (this frame at another scale, or a neighbouring
-/// frame of the sequence) with the same settings: Lee et al.'s warm start,
-/// since features move little from frame to frame.
+/// The frame's thin plates on `side`. In a viewer's interactive render,
+/// solved from the plates this instance solved nearest in time (this frame
+/// at another scale, or a neighbouring frame) with the same settings: Lee
+/// et al.'s warm start, since features move little from frame to frame. A
+/// warm start lands within the solver's tolerance of the cold solution, not
+/// on its bits, so final renders (sequential or not) always start cold.
 pub(super) fn thin_plate(
     instance: &NodeState,
     inputs: &WarpInputs,
     side: Side,
-    (time, sequential): (f64, bool),
+    (time, interactive): (f64, bool),
 ) -> Outcome<ThinPlateWarp> {
     let setup = Key::of(&(side, &inputs.warp.settings.thin_plate, inputs.warp.region));
-    // Warm starts only in a sequential render (see `correspondence`).
-    let warm = sequential
+    let warm = interactive
         .then(|| {
             let plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
             plates
