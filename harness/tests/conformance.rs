@@ -586,3 +586,34 @@ fn interlaced_footage_is_warped_one_field_at_a_time() {
         }
     }
 }
+
+#[test]
+fn the_ghost_and_folds_views_ask_for_rgba_output() {
+    // Their measure is in alpha: a host that follows RGB sources with an
+    // RGB output (Natron) would drop it unless the node asks for RGBA.
+    let name = c"OfxImageClipPropComponents_Output";
+    for (id, context, views) in [
+        (
+            "net.morphfx.Morph",
+            "OfxImageEffectContextGeneral",
+            &["ghost", "folds", "morph"][..],
+        ),
+        (
+            "net.morphfx.Warp",
+            "OfxImageEffectContextFilter",
+            &["folds", "warped"][..],
+        ),
+    ] {
+        let inst = bundle().instance(id, context).unwrap();
+        for view in views {
+            inst.set_choice("view", view).unwrap();
+            let out = inst.clip_preferences_from("OfxImageComponentRGB").unwrap();
+            let want = if matches!(*view, "ghost" | "folds") {
+                "OfxImageComponentRGBA"
+            } else {
+                "OfxImageComponentRGB"
+            };
+            assert_eq!(out.str(name).as_deref(), Some(want), "{id} {view}");
+        }
+    }
+}

@@ -390,6 +390,9 @@ fn key_shapes_here_and_copy_scene_into_node() {
     ov.drag(0.0, (150.0, 130.0), (170.0, 130.0), PX).unwrap();
     let message = inst.persistent_message().expect("a message on the node");
     assert!(message.contains("Copy Scene Into Node"), "{message}");
+    // A warning: the node renders fine, and an error would mark it failed.
+    let kind = inst.effect.persistent.lock().unwrap().clone().unwrap().kind;
+    assert_eq!(kind, "OfxMessageWarning");
     assert_eq!(scene_text(&inst), "");
     inst.instance_changed("copy_scene", 0.0).unwrap();
     assert_eq!(inst.string("scene_file").unwrap(), "");

@@ -509,9 +509,17 @@ impl Instance<'_> {
     }
 
     /// The plugin's clip preferences (`kOfxImageEffectActionGetClipPreferences`),
-    /// as hosts ask after connecting clips: the out-args it set.
+    /// as hosts ask after connecting clips: the out-args it set. This host
+    /// renders RGBA, so that is the output's default.
     pub fn clip_preferences(&self) -> Result<PropertySet, HostError> {
+        self.clip_preferences_from("OfxImageComponentRGBA")
+    }
+
+    /// The same with the output's components defaulting to `output` (a
+    /// host following RGB sources offers `OfxImageComponentRGB`).
+    pub fn clip_preferences_from(&self, output: &str) -> Result<PropertySet, HostError> {
         let out = PropertySet::new();
+        out.set_str(c"OfxImageClipPropComponents_Output", output);
         out.set_int(kOfxImageEffectFrameVarying, &[0]);
         out.set_str(
             kOfxImageEffectPropPreMultiplication,

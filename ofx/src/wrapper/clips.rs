@@ -197,6 +197,16 @@ impl EffectHandle {
     /// the node until [`EffectHandle::clear_persistent`]. False when the host has
     /// no v2 suite (the caller then posts a transient message).
     pub(crate) fn persistent_error(&self, id: &CStr, text: &str) -> bool {
+        self.persistent(kOfxMessageError, id, text)
+    }
+
+    /// As [`EffectHandle::persistent_error`], a warning: something refused
+    /// that leaves the node working (hosts show no error badge for it).
+    pub(crate) fn persistent_warning(&self, id: &CStr, text: &str) -> bool {
+        self.persistent(kOfxMessageWarning, id, text)
+    }
+
+    fn persistent(&self, kind: &CStr, id: &CStr, text: &str) -> bool {
         let Some(f) = self.suites.message_v2.and_then(|s| s.setPersistentMessage) else {
             return false;
         };
@@ -207,7 +217,7 @@ impl EffectHandle {
         let status = unsafe {
             f(
                 self.handle as *mut c_void,
-                kOfxMessageError.as_ptr(),
+                kind.as_ptr(),
                 id.as_ptr(),
                 text.as_ptr(),
             )

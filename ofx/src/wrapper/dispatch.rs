@@ -220,6 +220,14 @@ fn clip_preferences<E: ImageEffect>(effect: &EffectHandle, out_args: &PropSet) -
     if let Some(varying) = prefs.frame_varying {
         out_args.set_int(kOfxImageEffectFrameVarying, 0, varying as i32)?;
     }
+    if prefs.rgba_output {
+        // The spec: `OfxImageClipPropComponents_` with the clip's name.
+        out_args.set_string(
+            c"OfxImageClipPropComponents_Output",
+            0,
+            &kOfxImageComponentRGBA.to_string_lossy(),
+        )?;
+    }
     if let Some(premultiplied) = prefs.premultiplied_output {
         let state = if premultiplied {
             kOfxImagePreMultiplied

@@ -147,6 +147,7 @@ impl FramesNeeded {
 pub struct ClipPreferences {
     pub(super) frame_varying: Option<bool>,
     pub(super) premultiplied_output: Option<bool>,
+    pub(super) rgba_output: bool,
 }
 
 impl ClipPreferences {
@@ -157,6 +158,11 @@ impl ClipPreferences {
     /// The output's colour is premultiplied by its alpha (else straight).
     pub fn set_premultiplied_output(&mut self, premultiplied: bool) {
         self.premultiplied_output = Some(premultiplied);
+    }
+    /// The output must be RGBA whatever the sources are (its alpha carries
+    /// what the node shows), where a host would otherwise follow RGB sources.
+    pub fn set_rgba_output(&mut self) {
+        self.rgba_output = true;
     }
 }
 

@@ -36,8 +36,10 @@ pub fn write(instance: &NodeState, doc: &Document) -> Outcome {
 
 /// Shows why an edit was refused on the node until the next edit that
 /// works (a transient warning where the host keeps no persistent message).
+/// A warning, not an error: the node still renders, and an error would
+/// mark it failed (Natron's ERROR badge) for a click the viewer ignored.
 pub fn refuse(effect: &EffectHandle, why: &Failure) {
-    if !effect.persistent_error(REFUSED, why.message()) {
+    if !effect.persistent_warning(REFUSED, why.message()) {
         effect.warning(REFUSED, why.message());
     }
 }

@@ -6,7 +6,7 @@ use morphfx::geom::{RectD, Vec2};
 use morphfx::views::View;
 
 use super::inputs::{warp_inputs, WarpInputs};
-use crate::nodes::params::{Reader, Settings, OFFSET_A, OFFSET_B};
+use crate::nodes::params::{views, Reader, Settings, OFFSET_A, OFFSET_B, VIEW};
 use crate::nodes::{NodeKind, NodeState, MASK_CLIP, TIMING_CLIP};
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::plugin::{ClipPreferences, FramesNeeded, Identity, RenderArgs, Rois};
@@ -98,6 +98,12 @@ pub fn clip_preferences(
         }
     }
     out.set_premultiplied_output(straight.is_empty() || !straight.iter().all(|s| *s));
+    // The ghost and folds views put their measure in alpha: an RGB output
+    // (what hosts give RGB sources) would drop it.
+    let view = Reader::new(node.params(), node.kind, 0.0).pick(&VIEW, views(node.kind));
+    if matches!(view, View::Ghost | View::Folds) {
+        out.set_rgba_output();
+    }
     Ok(Reply::Done)
 }
 
