@@ -1,8 +1,10 @@
 //! Frame IO. EXR is read and written at full precision (half or float), as
-//! linear light. PNG, JPEG and TIFF with 8- or 16-bit samples hold sRGB code
-//! values: they are decoded to linear on read and PNG is encoded to sRGB on
-//! write, as a compositor's Read and Write nodes do, unless the caller asks
-//! for the raw code values ([`Colour::Raw`]); float TIFF is linear already.
+//! linear light, premultiplied. PNG, JPEG and TIFF with 8- or 16-bit samples
+//! hold straight sRGB code values: they are decoded to linear and
+//! premultiplied on read, and PNG and TIFF are unpremultiplied and encoded
+//! to sRGB on write, as a compositor's Read and Write nodes do, unless the
+//! caller asks for the raw code values ([`Colour::Raw`], both ways as they
+//! are); float TIFF is linear already.
 //! Outputs go to a temporary name and are renamed when complete.
 
 use std::path::Path;
@@ -447,9 +449,12 @@ fn read_other(path: &Path, colour: Colour) -> std::result::Result<Plate, HostErr
     let decode = colour == Colour::Srgb && !float;
     let mut rgba = img.to_rgba32f();
     if decode {
+        // PNG, JPEG and 8/16-bit TIFF hold straight colour; the render
+        // works premultiplied, as EXR stores it.
         for p in rgba.pixels_mut() {
+            let a = p.0[3];
             for c in &mut p.0[..3] {
-                *c = srgb_to_linear(*c);
+                *c = srgb_to_linear(*c) * a;
             }
         }
     }
@@ -648,8 +653,19 @@ fn write_other(
     let (w, h) = (img.width(), img.height());
     let mut out = ::image::RgbaImage::new(w as u32, h as u32);
     let code = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    // PNG and TIFF hold straight colour (their convention, and what hosts'
+    // writers store): the premultiplied render is divided by its alpha.
+    // JPEG has no alpha: its colour stays premultiplied, the picture over
+    // black.
+    let straight = ext != "jpg" && ext != "jpeg";
     for (x, y, p) in out.enumerate_pixels_mut() {
-        let v = rgba_at(plate, x as usize, y as usize);
+        let mut v = rgba_at(plate, x as usize, y as usize);
+        if colour == Colour::Srgb && straight && v[3] > 0.0 && v[3] < 1.0 {
+            let a = v[3];
+            for c in &mut v[..3] {
+                *c /= a;
+            }
+        }
         p.0 = match colour {
             Colour::Srgb => [
                 code(linear_to_srgb(v[0])),

@@ -493,6 +493,40 @@ fn png_plates_are_decoded_from_srgb_and_png_outputs_encoded_unless_raw() {
     }
 }
 
+/// PNG holds straight colour, the render premultiplied colour: a half
+/// transparent PNG is premultiplied on read (EXR out holds colour × alpha)
+/// and written back straight, the same code values (as a host's PNG
+/// writer writes them), with or without --raw.
+#[test]
+fn png_alpha_is_straight_in_the_file_and_premultiplied_in_the_render() {
+    let d = tmp("png-alpha");
+    let png = d.join("half.png");
+    ::image::RgbaImage::from_pixel(24, 16, ::image::Rgba([128, 64, 255, 128]))
+        .save(&png)
+        .unwrap();
+    let warp = |out: &str, extra: &[&str]| {
+        let out = d.join(out);
+        let mut args = vec!["warp", "--line", IDENTITY, "--input", png.to_str().unwrap()];
+        args.extend_from_slice(&["--t", "0", "-o", out.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let (code, err) = morphfx(&args);
+        assert_eq!(code, 0, "{err}");
+        out
+    };
+    let exr = io::read_as(&warp("linear.exr", &[]), io::Colour::Raw)
+        .unwrap()
+        .image;
+    let (px, a) = (exr.pixel(5, 5), 128.0 / 255.0);
+    assert!((px[3] - a).abs() < 1e-6, "{px:?}");
+    // Code 128 is 0.21586 of linear light, straight; premultiplied by alpha.
+    assert!((px[0] - 0.21586 * a).abs() < 1e-4, "{px:?}");
+    assert!((px[2] - a).abs() < 1e-4, "{px:?}");
+    for (name, extra) in [("back.png", &[][..]), ("back_raw.png", &["--raw"][..])] {
+        let back = ::image::open(warp(name, extra)).unwrap().to_rgba8();
+        assert_eq!(back.get_pixel(5, 5).0, [128, 64, 255, 128], "{name}");
+    }
+}
+
 /// A header that claims 32768 × 32768 pixels in a file of a few hundred
 /// bytes: refused from its header with the limit named, before any pixel
 /// is read or any memory asked for, and nothing written.

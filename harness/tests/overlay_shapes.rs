@@ -363,13 +363,18 @@ fn the_curve_tool_inserts_a_point_on_a_segment_and_delete_removes_points_and_sha
 
 #[test]
 fn key_shapes_here_and_copy_scene_into_node() {
+    // Keyed at the time the host's instance-changed action names, frame 0
+    // included (a key at 1 there would be the host's time, not ours).
+    for at in [0.0, 12.0] {
+        let inst = morph();
+        inst.set_string("scene_text", SHAPES).unwrap();
+        inst.instance_changed("key_shapes", at).unwrap();
+        let s = scene(&inst);
+        assert_eq!(s.keyframes.len(), 1);
+        assert_eq!(s.keyframes[0].frame, at);
+        assert_eq!(s.features_at(0.0), Scene::read(SHAPES).unwrap().features);
+    }
     let inst = morph();
-    inst.set_string("scene_text", SHAPES).unwrap();
-    inst.instance_changed("key_shapes", 12.0).unwrap();
-    let s = scene(&inst);
-    assert_eq!(s.keyframes.len(), 1);
-    assert_eq!(s.keyframes[0].frame, 12.0);
-    assert_eq!(s.features_at(0.0), Scene::read(SHAPES).unwrap().features);
     // A scene file's features are drawn, dimmer, and the pen cannot move them.
     let dir = common::scratch("overlay-shapes-copy");
     let path = dir.join("face.morph.json");
