@@ -87,12 +87,17 @@ pub enum Command {
     Morph {
         #[command(flatten)]
         common: Common,
+        /// Plate A (file or #-numbered sequence): the morph at t = 0.
         #[arg(long)]
         a: String,
+        /// Plate B (file or #-numbered sequence): the morph at t = 1.
         #[arg(long)]
         b: String,
+        /// Also write the ST map A was warped with (file or #-numbered
+        /// sequence, 32-bit float EXR).
         #[arg(long = "stmap-a")]
         stmap_a: Option<String>,
+        /// Also write the ST map B was warped with.
         #[arg(long = "stmap-b")]
         stmap_b: Option<String>,
         /// morph, warped-a, warped-b, stmap-a, stmap-b, transition, grid, ghost, folds
@@ -114,8 +119,11 @@ pub enum Command {
     Warp {
         #[command(flatten)]
         common: Common,
+        /// The plate to warp (file or #-numbered sequence).
         #[arg(long)]
         input: String,
+        /// Also write the ST map the input was warped with (file or
+        /// #-numbered sequence, 32-bit float EXR).
         #[arg(long)]
         stmap: Option<String>,
         /// warped, stmap, grid, folds
@@ -134,6 +142,7 @@ pub enum Command {
     },
     /// Render a morph of built-in generated plates.
     Demo {
+        /// The folder the demo's frames, contact sheet and notes go to.
         #[arg(short = 'o', long = "output", default_value = "morphfx-demo")]
         output: PathBuf,
     },
@@ -145,6 +154,7 @@ pub enum Command {
         /// Source A (with --b: the Morph node's overlay).
         #[arg(long, conflicts_with = "input")]
         a: Option<String>,
+        /// Source B (with --a: the Morph node's overlay; drawn on with --show b).
         #[arg(long, requires = "a")]
         b: Option<String>,
         /// The source of the Warp node's overlay.
@@ -159,12 +169,16 @@ pub enum Command {
     /// Refine the scene's polylines and curves onto nearby edges of A and B
     /// with snakes, and write the refined scene.
     Snap {
+        /// The scene whose polylines and curves are refined.
         #[arg(long)]
         scene: PathBuf,
+        /// Plate A: the features' A positions snap to its edges.
         #[arg(long)]
         a: String,
+        /// Plate B: the features' B positions snap to its edges.
         #[arg(long)]
         b: String,
+        /// The refined scene.
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
         /// The keyframe to refine (scenes with keyframes), and the frame of
@@ -184,6 +198,7 @@ pub enum Command {
     /// Follow the scene's keyed features through sequence A (and B) and
     /// write the scene with a keyframe at every frame of the range.
     Track {
+        /// The scene whose keyed features are followed.
         #[arg(long)]
         scene: PathBuf,
         /// Sequence A, #-numbered (plate.####.exr).
@@ -215,12 +230,17 @@ pub enum Command {
     /// say where the time went; with --drag, the re-render after one of 100
     /// lines moves, as while a compositor drags it.
     Bench {
-        #[arg(short = 'o', long = "output", default_value = "morphfx-bench")]
-        output: PathBuf,
+        /// Where the plates and the morph are written and kept (default: a
+        /// temporary folder, removed when the bench ends).
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+        /// Frames of the generated shot.
         #[arg(long, default_value_t = 48)]
         frames: usize,
+        /// Width of the generated plates, pixels.
         #[arg(long, default_value_t = 1920)]
         width: usize,
+        /// Height of the generated plates, pixels.
         #[arg(long, default_value_t = 1080)]
         height: usize,
         /// Time renders after a line moves (in this process, no files).
@@ -297,6 +317,25 @@ pub fn expand_extra_args(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every option of every command says what it is in `--help`.
+    #[test]
+    fn every_option_has_help_text() {
+        use clap::CommandFactory;
+        fn check(c: &clap::Command, path: &str) {
+            for arg in c.get_arguments() {
+                let id = arg.get_id().as_str();
+                if matches!(id, "help" | "version") {
+                    continue;
+                }
+                assert!(arg.get_help().is_some(), "{path} --{id} has no help text");
+            }
+            for sub in c.get_subcommands() {
+                check(sub, &format!("{path} {}", sub.get_name()));
+            }
+        }
+        check(&Cli::command(), "morphfx");
+    }
 
     fn expand(args: &[&str]) -> Vec<String> {
         expand_extra_args(args.iter().map(std::ffi::OsString::from))

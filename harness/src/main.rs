@@ -125,7 +125,7 @@ fn run(cli: Cli) -> Result<(), HostError> {
             width,
             height,
             ..
-        } => bench::bench(&bundle_path()?, &output, frames, (width, height)),
+        } => bench::bench_in(&bundle_path()?, output.as_deref(), frames, (width, height)),
     }
 }
 

@@ -676,3 +676,34 @@ fn stmaps_are_float_from_half_plates() {
         }
     }
 }
+
+/// `morphfx bench` leaves nothing where it runs unless told where to keep
+/// its plates (a 1080p run writes about 330 MB).
+#[test]
+fn bench_keeps_its_plates_only_under_the_folder_it_is_given() {
+    let d = tmp("bench-clean");
+    let run = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_morphfx"))
+            .arg("--bundle")
+            .arg(common::bundle_path())
+            .args(["bench", "--frames", "2", "--width", "32", "--height", "24"])
+            .args(extra)
+            .current_dir(&d)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    run(&[]);
+    assert_eq!(
+        std::fs::read_dir(&d).unwrap().count(),
+        0,
+        "bench left files"
+    );
+    run(&["-o", "kept"]);
+    assert!(d.join("kept/plates/a.0002.exr").is_file());
+    assert!(d.join("kept/morph.0002.exr").is_file());
+}

@@ -209,7 +209,7 @@ fn a_job_is_checked_as_a_worker_would_before_it_is_written() {
             "job",
             "openjd",
             "-o",
-            &*job.to_str().unwrap(),
+            job.to_str().unwrap(),
             "--",
             "warp",
             "--scene",
@@ -240,10 +240,17 @@ fn a_job_is_checked_as_a_worker_would_before_it_is_written() {
         assert!(err.contains(why), "{extra:?}: {err}");
         assert!(!job.exists(), "{extra:?} wrote the job");
     }
-    let r = submit(&[&scene], "1001-1011x5", &out);
+    // Paths reach the workers absolute and without `..`.
+    let roundabout = format!(
+        "{}/../{}/out.####.exr",
+        d.display(),
+        d.file_name().unwrap().to_string_lossy()
+    );
+    let r = submit(&[&scene], "1001-1011x5", &roundabout);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let values: serde_json::Value =
         serde_json::from_slice(&std::fs::read(job.join("openjd_parameters.json")).unwrap())
             .unwrap();
     assert_eq!(values["Frames"], "1001-1011:5");
+    assert_eq!(values["Output"], out.as_str());
 }

@@ -305,11 +305,29 @@ fn keyed_params_interpolate_and_params_lists_every_id() {
         "mask_invert ",
         "view ",
         "transition_spread ",
-        "line64_b_end ",
+        "line1_b_end ",
+        "line2_... to line64_...",
+        "auto_levels ",
     ] {
         assert!(text.contains(id), "{id} missing from:\n{text}");
     }
     assert!(text.contains("ghost") && text.contains("folds"));
+    // One screenful or so, with each param's label as a host shows it.
+    assert!(text.lines().count() < 100, "{} lines", text.lines().count());
+    assert!(text
+        .lines()
+        .any(|l| l.starts_with("field_b ") && l.ends_with(" b")));
+    assert!(text
+        .lines()
+        .any(|l| l.starts_with("mix ") && l.ends_with(" Mix")));
+    assert!(!text.contains("line2_a_start"));
+    // The Warp node has no auto method, so none of its params.
+    let warp = common::run_morphfx(&["params", "--node", "warp"]);
+    let warp = String::from_utf8_lossy(&warp.stdout);
+    assert!(
+        warp.contains("field_b ") && !warp.contains("auto_"),
+        "{warp}"
+    );
     let (code, _) = morphfx(&["params", "--node", "blur"]);
     assert_eq!(code, 2);
 }
@@ -327,7 +345,7 @@ fn mattes_without_alpha_act_by_their_mean() {
     let level = |x: u32| (x * 255 / (w - 1)) as u8;
     let rgb = ::image::RgbImage::from_fn(w, h, |x, _| {
         let v = level(x);
-        ::image::Rgb([v, v / 2, v.saturating_add(v / 2).min(255)])
+        ::image::Rgb([v, v / 2, v.saturating_add(v / 2)])
     });
     rgb.save(d.join("rgb.png")).unwrap();
     let grey = ::image::GrayImage::from_fn(w, h, |x, _| ::image::Luma([level(x)]));
@@ -341,8 +359,7 @@ fn mattes_without_alpha_act_by_their_mean() {
     };
     let mean = |x: u32| {
         let v = level(x) as f32;
-        (v + (level(x) / 2) as f32 + (level(x).saturating_add(level(x) / 2)).min(255) as f32)
-            / (3.0 * 255.0)
+        (v + (level(x) / 2) as f32 + level(x).saturating_add(level(x) / 2) as f32) / (3.0 * 255.0)
     };
     as_alpha("rgb-alpha.png", &mean);
     as_alpha("grey-alpha.png", &|x| level(x) as f32 / 255.0);
@@ -457,12 +474,10 @@ fn a_timing_matte_keeps_plates_opaque_and_holds_a_to_the_edge() {
                 // t = 0.5, so the dissolve shows warped A alone (B differs
                 // from A by up to 0.8 there).
                 if i < 30 {
-                    for c in 0..3 {
-                        let want = warped_a.pixel(i, j)[c];
+                    for (c, (g, want)) in px.iter().zip(warped_a.pixel(i, j)).take(3).enumerate() {
                         assert!(
-                            (px[c] - want).abs() < 1e-4,
-                            "t {t} ({i}, {j}) {c}: {} where the matte holds A ({want})",
-                            px[c]
+                            (g - want).abs() < 1e-4,
+                            "t {t} ({i}, {j}) {c}: {g} where the matte holds A ({want})"
                         );
                     }
                 }
@@ -501,7 +516,7 @@ fn params_the_scene_overrides_are_refused_or_honoured_never_ignored() {
         "line_interpolation=center-angle",
         "evaluation=adaptive",
         "mesh_pass=one-pass",
-        "auto_levels=3",
+        "mffd_alpha=0.3",
         "plate_alpha=10",
     ] {
         let ((code, err), out) = warp(&["--param", refused], "refused.exr");

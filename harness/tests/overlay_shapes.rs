@@ -374,7 +374,6 @@ fn key_shapes_here_and_copy_scene_into_node() {
         assert_eq!(s.keyframes[0].frame, at);
         assert_eq!(s.features_at(0.0), Scene::read(SHAPES).unwrap().features);
     }
-    let inst = morph();
     // A scene file's features are drawn, dimmer, and the pen cannot move them.
     let dir = common::scratch("overlay-shapes-copy");
     let path = dir.join("face.morph.json");

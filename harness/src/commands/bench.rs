@@ -14,6 +14,23 @@ use crate::host::HostError;
 use crate::io::{self, ExrPrecision, Plate};
 use crate::sequence::frame_path;
 
+/// [`bench`] in `dir`, kept; without one, in a temporary folder removed
+/// when it ends (a 1080p run writes about 330 MB).
+pub fn bench_in(
+    bundle_path: &Path,
+    dir: Option<&Path>,
+    frames: usize,
+    size: (usize, usize),
+) -> Result<(), HostError> {
+    if let Some(dir) = dir {
+        return bench(bundle_path, dir, frames, size);
+    }
+    let scratch = std::env::temp_dir().join(format!("morphfx-bench-{}", std::process::id()));
+    let result = bench(bundle_path, &scratch, frames, size);
+    let _ = std::fs::remove_dir_all(&scratch);
+    result
+}
+
 /// Plate sequences A and B of `frames` frames (a drifting pattern each), a
 /// scene of 20 keyframed lines, then the morph of the whole range timed as a
 /// user runs it: read plates, render through the bundle, write float EXR.

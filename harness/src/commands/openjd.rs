@@ -220,11 +220,23 @@ impl Options {
     }
 }
 
-/// `path` made absolute against the current folder, as a worker needs it.
+/// `path` made absolute against the current folder, as a worker needs it,
+/// with `.` and `..` folded away (by name: outputs need not exist yet).
 fn absolute(path: &Path) -> Result<String, HostError> {
-    std::path::absolute(path)
-        .map(|p| p.to_string_lossy().into_owned())
-        .map_err(|e| HostError::bad(format!("{}: {e}", path.display())))
+    use std::path::Component;
+    let full = std::path::absolute(path)
+        .map_err(|e| HostError::bad(format!("{}: {e}", path.display())))?;
+    let mut folded = PathBuf::new();
+    for part in full.components() {
+        match part {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                folded.pop();
+            }
+            other => folded.push(other),
+        }
+    }
+    Ok(folded.to_string_lossy().into_owned())
 }
 
 /// The morphfx command: a name on the workers' PATH stays as it is, a path

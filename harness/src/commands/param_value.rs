@@ -142,11 +142,24 @@ impl ParamSetting {
 /// One line per param of `inst`: id, type, default, range or options, and
 /// whether it animates; groups and pages are left out.
 pub fn param_lines(inst: &Instance<'_>) -> Vec<String> {
-    let mut lines = Vec::new();
+    let mut lines = vec![format!(
+        "{:<24} {:<9} {:<30} {:<40} {}",
+        "ID", "TYPE", "DEFAULT", "RANGE OR OPTIONS", "LABEL"
+    )];
+    let mut slots = 0;
     for (id, kind) in inst.param_names() {
         let Some(p) = inst.param_props(&id) else {
             continue;
         };
+        // The line slots repeat one block of params: slot 1 is listed, the
+        // rest said in one line after it.
+        match line_slot(&id) {
+            Some(1) | None => {}
+            Some(k) => {
+                slots = slots.max(k);
+                continue;
+            }
+        }
         let short = kind.trim_start_matches("OfxParamType");
         let (default, range) = match short {
             "Double" | "Double2D" => {
@@ -200,12 +213,36 @@ pub fn param_lines(inst: &Instance<'_>) -> Vec<String> {
             _ => continue, // groups, pages and buttons hold no value
         };
         let animates = p.ints(kOfxParamPropAnimates).first() != Some(&0) && short != "String";
+        let label = p
+            .str(openfx::sys::generic::core::kOfxPropLabel)
+            .unwrap_or_default();
+        let range = if animates {
+            format!("{range} (animates)")
+        } else {
+            range
+        };
         lines.push(format!(
-            "{id:<24} {short:<9} default {default:<22} {range}{}",
-            if animates { "  (animates)" } else { "" }
+            "{id:<24} {short:<9} {default:<30} {range:<40} {label}"
         ));
     }
+    if slots > 1 {
+        let at = lines
+            .iter()
+            .rposition(|l| line_slot(l.split(' ').next().unwrap_or("")) == Some(1))
+            .map_or(lines.len(), |k| k + 1);
+        lines.insert(
+            at,
+            format!("line2_... to line{slots}_...: as line1_..., one block per line slot"),
+        );
+    }
     lines
+}
+
+/// The line slot a param id belongs to (`line12_a_start`: 12).
+fn line_slot(id: &str) -> Option<usize> {
+    let rest = id.strip_prefix("line")?;
+    let (k, _) = rest.split_once('_')?;
+    k.parse().ok()
 }
 
 #[cfg(test)]

@@ -75,7 +75,10 @@ impl Settings {
             mesh: MeshSettings {
                 pass: r.choice(&MESH_PASS),
             },
-            auto: auto_settings(&r),
+            auto: match kind {
+                NodeKind::Morph => auto_settings(&r),
+                NodeKind::Warp => AutoSettings::default(),
+            },
             thin_plate: ThinPlateSettings {
                 alpha: r.double(&PLATE_ALPHA),
                 beta: r.double(&PLATE_BETA),

@@ -106,6 +106,10 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(KEY_SHAPES, "Key Shapes Here", "Keys Scene Text's shapes at the current frame (a static scene becomes keyed); from then on an edit at a frame keys that frame.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(COPY_SCENE, "Copy Scene Into Node", "Copies Scene File's scene into Scene Text and empties Scene File, so its shapes can be edited in the viewer.", Kind::Button).in_group("lines_group"),
     ];
+    if kind == NodeKind::Warp {
+        // The Warp node has no `auto` method (it needs two pictures).
+        t.retain(|p| p.id != "auto_group" && p.group.as_deref() != Some("auto_group"));
+    }
     for k in 1..=LINE_SLOTS {
         t.extend(slot_specs(k));
     }
