@@ -43,12 +43,13 @@ impl Snap<'_> {
             .map_err(|e| HostError::bad(format!("scene {}: {e}", self.scene.display())))?;
         let mut doc: Value = serde_json::from_str(&text)
             .map_err(|e| HostError::bad(format!("scene {}: {e}", self.scene.display())))?;
-        let features = self.features_to_refine(&scene, &mut doc)?;
+        let at = self.frame_in(&scene);
+        let features = self.features_to_refine(&scene, at, &mut doc)?;
 
-        let frame = self.frame.unwrap_or(0.0).round() as i64;
+        let frame = at.unwrap_or(0.0).round() as i64;
         let plate = |pattern: &str| {
             let path = if is_sequence(pattern) {
-                if self.frame.is_none() {
+                if at.is_none() {
                     return Err(HostError::bad(format!(
                         "{pattern}: a numbered sequence needs --frame"
                     )));
@@ -102,6 +103,7 @@ impl Snap<'_> {
                 snake.points
             };
             let (a, b) = (side("a", &energy_a), side("b", &energy_b));
+            let (a, b) = without_coinciding(a, b, closed);
             f["type"] = Value::from("polyline");
             f["a"] = to_json(&a);
             f["b"] = to_json(&b);
@@ -120,17 +122,27 @@ impl Snap<'_> {
         Ok(())
     }
 
+    /// The frame refined: `--frame`, else a scene's only keyframe (there is
+    /// no choice to make).
+    fn frame_in(&self, scene: &Scene) -> Option<f64> {
+        match scene.keyframes.as_slice() {
+            [only] => self.frame.or(Some(only.frame)),
+            _ => self.frame,
+        }
+    }
+
     /// The feature list to edit: the static features, or the keyframe at
-    /// `--frame` when the scene has keyframes.
+    /// `frame` when the scene has keyframes.
     fn features_to_refine<'d>(
         &self,
         scene: &Scene,
+        frame: Option<f64>,
         doc: &'d mut Value,
     ) -> Result<&'d mut Value, HostError> {
         if scene.keyframes.is_empty() {
             return Ok(&mut doc["features"]);
         }
-        let Some(frame) = self.frame else {
+        let Some(frame) = frame else {
             let keys: Vec<String> = scene
                 .keyframes
                 .iter()
@@ -184,4 +196,53 @@ pub fn write_atomically(path: &Path, text: &str) -> Result<(), HostError> {
             let _ = std::fs::remove_file(&tmp);
             HostError::bad(format!("{}: cannot write: {e}", path.display()))
         })
+}
+
+/// A snake can pull two neighbouring samples onto one point (a tight
+/// corner), which no scene allows: such a sample is dropped from both
+/// sides, so they still correspond point for point.
+fn without_coinciding(a: Vec<Vec2>, b: Vec<Vec2>, closed: bool) -> (Vec<Vec2>, Vec<Vec2>) {
+    // Points are written to 1/1000 px (`to_json`): any two that round to
+    // one are under 0.0015 px apart.
+    const SAME: f64 = 0.0015;
+    let (mut ka, mut kb): (Vec<Vec2>, Vec<Vec2>) = (Vec::new(), Vec::new());
+    for (p, q) in a.into_iter().zip(b) {
+        let repeats = |kept: &[Vec2], p: Vec2| kept.last().is_some_and(|l| l.distance(p) < SAME);
+        if !(repeats(&ka, p) || repeats(&kb, q)) {
+            ka.push(p);
+            kb.push(q);
+        }
+    }
+    // A closed shape's last point meets its first again.
+    while closed && ka.len() > 3 {
+        let (la, lb) = (ka[ka.len() - 1], kb[kb.len() - 1]);
+        if la.distance(ka[0]) < SAME || lb.distance(kb[0]) < SAME {
+            ka.pop();
+            kb.pop();
+        } else {
+            break;
+        }
+    }
+    (ka, kb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coinciding_samples_go_from_both_sides() {
+        let p = |x: f64| Vec2::new(x, 0.0);
+        // b[1] and b[2] coincide: sample 2 goes from A too.
+        let a = vec![p(0.0), p(1.0), p(2.0), p(3.0)];
+        let b = vec![p(0.0), p(5.0), p(5.0), p(7.0)];
+        let (a2, b2) = without_coinciding(a, b, false);
+        assert_eq!(a2, vec![p(0.0), p(1.0), p(3.0)]);
+        assert_eq!(b2, vec![p(0.0), p(5.0), p(7.0)]);
+        // Closed: a last point back on the first goes.
+        let a = vec![p(0.0), p(1.0), p(2.0), p(3.0), p(0.0)];
+        let b = vec![p(0.0), p(1.0), p(2.0), p(3.0), p(4.0)];
+        let (a2, b2) = without_coinciding(a, b, true);
+        assert_eq!((a2.len(), b2.len()), (4, 4));
+    }
 }

@@ -397,6 +397,42 @@ fn cmake_install_check(morphfx: &Path) {
         "cmake install check: {} loads and lists both plugins",
         installed.display()
     );
+    morphfx_install_check(&prefix);
+}
+
+/// The README's `cargo install --path harness`, into the prefix the CMake
+/// check installed the bundle under (the dev profile, in the workspace's
+/// target folder, so it reuses what the tests built): the installed command
+/// finds that bundle through `OFX_PLUGIN_PATH` and lists both plugins.
+fn morphfx_install_check(prefix: &Path) {
+    let mut c = cargo_command();
+    c.args([
+        "install", "--quiet", "--debug", "--path", "harness", "--root",
+    ])
+    .arg(prefix)
+    .env("CARGO_TARGET_DIR", target_dir());
+    run_cargo(c);
+    let installed = prefix.join("bin").join("morphfx");
+    let out = Command::new(&installed)
+        .arg("plugins")
+        .env("OFX_PLUGIN_PATH", prefix.join("OFX/Plugins"))
+        .current_dir(prefix)
+        .output()
+        .expect("the installed morphfx runs");
+    let listing = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() || !listing.contains("net.morphfx.Morph") {
+        eprintln!(
+            "morphfx install check failed: {} lists\n{listing}{}",
+            installed.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        exit(1);
+    }
+    println!(
+        "morphfx install check: cargo install --path harness gives {}, which finds the \
+         installed bundle through OFX_PLUGIN_PATH",
+        installed.display()
+    );
 }
 
 fn unsafe_env(key: &str, value: &Path) {
