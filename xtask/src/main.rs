@@ -212,6 +212,7 @@ fn test(cargo_args: &[String]) {
     let morphfx = dev_morphfx();
     farm::check(&morphfx, &b);
     cmake_install_check(&morphfx);
+    morphfx_install_check(&b);
 }
 
 /// Builds what the tests run, each in one cargo call per CPU level, and
@@ -397,26 +398,29 @@ fn cmake_install_check(morphfx: &Path) {
         "cmake install check: {} loads and lists both plugins",
         installed.display()
     );
-    morphfx_install_check(&prefix);
 }
 
-/// The README's `cargo install --path harness`, into the prefix the CMake
-/// check installed the bundle under (the dev profile, in the workspace's
-/// target folder, so it reuses what the tests built): the installed command
-/// finds that bundle through `OFX_PLUGIN_PATH` and lists both plugins.
-fn morphfx_install_check(prefix: &Path) {
+/// The README's `cargo install --path harness`, into a prefix of its own
+/// (the dev profile, in the workspace's target folder, so it reuses what
+/// the tests built): the installed command, run from elsewhere, finds the
+/// bundle in `bundle`'s folder through `OFX_PLUGIN_PATH` and lists both
+/// plugins.
+fn morphfx_install_check(bundle: &Path) {
+    let prefix = target_dir().join("install-check");
+    let _ = std::fs::remove_dir_all(&prefix);
     let mut c = cargo_command();
     c.args([
-        "install", "--quiet", "--debug", "--path", "harness", "--root",
+        "install", "--quiet", "--locked", "--debug", "--path", "harness", "--root",
     ])
-    .arg(prefix)
+    .arg(&prefix)
     .env("CARGO_TARGET_DIR", target_dir());
     run_cargo(c);
     let installed = prefix.join("bin").join("morphfx");
+    let folder = bundle.parent().expect("the bundle lies in a folder");
     let out = Command::new(&installed)
         .arg("plugins")
-        .env("OFX_PLUGIN_PATH", prefix.join("OFX/Plugins"))
-        .current_dir(prefix)
+        .env("OFX_PLUGIN_PATH", folder)
+        .current_dir(&prefix)
         .output()
         .expect("the installed morphfx runs");
     let listing = String::from_utf8_lossy(&out.stdout);
@@ -430,7 +434,7 @@ fn morphfx_install_check(prefix: &Path) {
     }
     println!(
         "morphfx install check: cargo install --path harness gives {}, which finds the \
-         installed bundle through OFX_PLUGIN_PATH",
+         bundle through OFX_PLUGIN_PATH",
         installed.display()
     );
 }
