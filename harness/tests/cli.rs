@@ -290,15 +290,43 @@ fn demo_renders_every_built_method_with_exact_end_frames() {
             .fold(0f32, f32::max);
         assert!(moved > 0.1, "{method}: the middle frame is plate A");
     }
-    // The features line the faces up: the middle frame's ghost is dark.
-    let ghost = read(d.join("ghost.0006.exr"));
-    let alpha: Vec<f32> = ghost.data.chunks(4).map(|p| p[3]).collect();
-    let mean = alpha.iter().sum::<f32>() / alpha.len() as f32;
-    let bright = alpha.iter().filter(|a| **a > 0.1).count() as f32 / alpha.len() as f32;
-    assert!(
-        mean < 0.05 && bright < 0.08,
-        "ghost mean {mean}, {bright} above 0.1"
-    );
+    // Every method lines the faces up: the middle frame's ghost is dark,
+    // and darkest where the eyes and mouth are (doubled eyes or a torn
+    // mouth light these boxes up, in-between positions, 160 x 120 centre).
+    for (method, ghost) in [
+        ("field", d.join("ghost.0006.exr")),
+        ("mesh", d.join("mesh/ghost.0006.exr")),
+        ("triangles", d.join("triangles/ghost.0006.exr")),
+        ("auto", d.join("auto/ghost.0006.exr")),
+    ] {
+        let ghost = read(ghost);
+        let alpha: Vec<f32> = ghost.data.chunks(4).map(|p| p[3]).collect();
+        let mean = alpha.iter().sum::<f32>() / alpha.len() as f32;
+        let bright = alpha.iter().filter(|a| **a > 0.1).count() as f32 / alpha.len() as f32;
+        assert!(
+            mean < 0.04 && bright < 0.08,
+            "{method}: ghost mean {mean}, {bright} above 0.1"
+        );
+        let boxed = |(x, y): (i32, i32), (hw, hh): (i32, i32)| {
+            let mut sum = 0.0;
+            for j in y - hh..y + hh {
+                for i in x - hw..x + hw {
+                    sum += ghost.pixel(160 + i, 120 + j)[3];
+                }
+            }
+            sum / (4 * hw * hh) as f32
+        };
+        for (part, centre, half) in [
+            ("left eye", (-32, 30), (13, 13)),
+            ("right eye", (32, 30), (13, 13)),
+            ("mouth", (0, -37), (44, 8)),
+        ] {
+            // The skins' own difference gives about 0.06; doubled eyes gave
+            // 0.2, a mouth held by one line along it 0.13.
+            let g = boxed(centre, half);
+            assert!(g < 0.09, "{method}: the {part} doubles (ghost {g} there)");
+        }
+    }
     // The last line names the contact sheet: every frame, half size, 4 across.
     let out = common::run_morphfx(&["demo", "-o", d.to_str().unwrap()]);
     let stdout = String::from_utf8_lossy(&out.stdout);
