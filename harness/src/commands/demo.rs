@@ -270,6 +270,9 @@ pub fn demo_scene((cx, cy): (f64, f64)) -> serde_json::Value {
     })
 }
 
+/// A mesh's nodes on A and on B, row by row.
+type MeshNodes = (Vec<[f64; 2]>, Vec<[f64; 2]>);
+
 /// Nodes per side of the demo's mesh: cells of 10 × 7.5 px, fine enough
 /// for the eyes (18 px across) to move on their own.
 const MESH_NODES: usize = 33;
@@ -280,7 +283,7 @@ const MESH_NODES: usize = 33;
 pub fn demo_mesh(
     (w, h): (usize, usize),
     scene: &serde_json::Value,
-) -> Result<(Vec<[f64; 2]>, Vec<[f64; 2]>), HostError> {
+) -> Result<MeshNodes, HostError> {
     use morphfx::features::Side;
     use morphfx::geom::{RectD, Vec2};
     let mut triangles = scene.clone();
