@@ -277,19 +277,9 @@ impl Pen<'_> {
                 Some(m.map_or(*p, |m| Vec2::new(m.x.min(p.x), m.y.min(p.y))))
             });
         let Some(corner) = corner else { return };
-        let list: Vec<String> = keys
-            .iter()
-            .map(|k| {
-                if (k - time).abs() < 1e-6 {
-                    format!("[{k}]")
-                } else {
-                    k.to_string()
-                }
-            })
-            .collect();
         self.colour(BETWEEN_COLOUR, 1.0);
         let at = self.at(corner - self.screen(0.0, 3.0 * LABEL_PX));
-        self.painter.text(at, &format!("keys {}", list.join(" ")));
+        self.painter.text(at, &key_list(keys, time));
     }
 
     /// A square of half-side `half_px` screen pixels around `c`, as four
@@ -318,5 +308,68 @@ fn sides(show: Show) -> Vec<(Side, [f32; 3])> {
         Show::A => vec![(Side::A, A_COLOUR)],
         Show::B => vec![(Side::B, B_COLOUR)],
         Show::Between | Show::Off => vec![],
+    }
+}
+
+/// The most keys the key list names one by one: a tracked scene keyed at
+/// every frame would otherwise run a line of hundreds of frames off the
+/// plate.
+const KEYS_LISTED: usize = 7;
+
+/// "keys 10 15 [20]": the frames keyed (`time`'s bracketed when it is one).
+/// Past [`KEYS_LISTED`], the first and last keys and those next to `time`,
+/// gaps as "…", and how many there are.
+pub(super) fn key_list(keys: &[f64], time: f64) -> String {
+    let name = |k: f64| {
+        if (k - time).abs() < 1e-6 {
+            format!("[{k}]")
+        } else {
+            k.to_string()
+        }
+    };
+    if keys.len() <= KEYS_LISTED {
+        let list: Vec<String> = keys.iter().map(|k| name(*k)).collect();
+        return format!("keys {}", list.join(" "));
+    }
+    // The keys around `time`: the last at or before it, and its neighbours.
+    let at = keys
+        .partition_point(|k| *k <= time + 1e-6)
+        .saturating_sub(1);
+    let near = at.saturating_sub(1)..=(at + 1).min(keys.len() - 1);
+    let mut shown: Vec<usize> = vec![0];
+    shown.extend(near);
+    shown.push(keys.len() - 1);
+    shown.dedup();
+    let mut words = Vec::new();
+    for (n, &k) in shown.iter().enumerate() {
+        if n > 0 && k > shown[n - 1] + 1 {
+            words.push("…".to_string());
+        }
+        words.push(name(keys[k]));
+    }
+    format!("keys {} ({} keys)", words.join(" "), keys.len())
+}
+
+#[cfg(test)]
+mod key_list_tests {
+    use super::key_list;
+
+    #[test]
+    fn few_keys_are_all_named_and_many_are_elided_around_the_time() {
+        assert_eq!(key_list(&[10.0, 15.0, 20.0], 20.0), "keys 10 15 [20]");
+        let every: Vec<f64> = (1001..=1048).map(f64::from).collect();
+        assert_eq!(
+            key_list(&every, 1020.0),
+            "keys 1001 … 1019 [1020] 1021 … 1048 (48 keys)"
+        );
+        assert_eq!(
+            key_list(&every, 1001.0),
+            "keys [1001] 1002 … 1048 (48 keys)"
+        );
+        assert_eq!(
+            key_list(&every, 1048.0),
+            "keys 1001 … 1047 [1048] (48 keys)"
+        );
+        assert_eq!(key_list(&every, 900.0), "keys 1001 1002 … 1048 (48 keys)");
     }
 }
