@@ -14,7 +14,7 @@ use crate::host::HostError;
 use crate::io::{self, ExrPrecision, Plate};
 use crate::sequence::frame_path;
 
-/// [`bench`] in `dir`, kept; without one, in a temporary folder removed
+/// [`bench()`] in `dir`, kept; without one, in a temporary folder removed
 /// when it ends (a 1080p run writes about 330 MB).
 pub fn bench_in(
     bundle_path: &Path,
