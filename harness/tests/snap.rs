@@ -97,8 +97,27 @@ fn snap_refuses_bad_input_without_writing() {
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("missing.exr"));
     assert!(!out.exists());
-    // A keyframed scene without --frame.
-    let keyed = r#"{"keyframes": [{"frame": 5, "features": [{"type": "polyline", "a": [[44, 10], [44, 54]], "b": [[48, 10], [48, 54]]}]}]}"#;
+    // A scene keyed at two frames without --frame: which is not said.
+    let key = |f: u32| {
+        format!(
+            r#"{{"frame": {f}, "features": [{{"type": "polyline", "a": [[44, 10], [44, 54]], "b": [[48, 10], [48, 54]]}}]}}"#
+        )
+    };
+    let two = format!(r#"{{"keyframes": [{}, {}]}}"#, key(5), key(9));
+    std::fs::write(d.join("two.json"), two).unwrap();
+    let r = run_snap(
+        &d.join("two.json"),
+        &d.join("a.exr"),
+        &d.join("a.exr"),
+        &out,
+        &[],
+    );
+    assert_eq!(r.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("--frame") && err.contains("5, 9"), "{err}");
+    assert!(!out.exists());
+    // Keyed at one frame, it needs none: that key is refined.
+    let keyed = format!(r#"{{"keyframes": [{}]}}"#, key(5));
     std::fs::write(d.join("k.json"), keyed).unwrap();
     let r = run_snap(
         &d.join("k.json"),
@@ -107,9 +126,9 @@ fn snap_refuses_bad_input_without_writing() {
         &out,
         &[],
     );
-    assert_eq!(r.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&r.stderr).contains("--frame"));
-    assert!(!out.exists());
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let alone = std::fs::read_to_string(&out).unwrap();
+    std::fs::remove_file(&out).unwrap();
     // With --frame 5 it refines that keyframe.
     let r = run_snap(
         &d.join("k.json"),
@@ -124,6 +143,11 @@ fn snap_refuses_bad_input_without_writing() {
         .a
         .iter()
         .all(|p| (p.x - 40.0).abs() < 0.5));
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap(),
+        alone,
+        "--frame 5 or none"
+    );
 }
 
 #[test]
