@@ -484,6 +484,23 @@ fn outputs_follow_the_first_inputs_precision_and_compression_unless_told() {
     assert!(!bad.exists());
 }
 
+/// `morphfx warp` of `input` by the identity line at t = 0 into `out`,
+/// with `extra` options: the plate as the IO reads and writes it.
+fn identity_warp(input: &Path, out: &Path, extra: &[&str]) -> PathBuf {
+    let mut args = vec![
+        "warp",
+        "--line",
+        IDENTITY,
+        "--input",
+        input.to_str().unwrap(),
+    ];
+    args.extend_from_slice(&["--t", "0", "-o", out.to_str().unwrap()]);
+    args.extend_from_slice(extra);
+    let (code, err) = morphfx(&args);
+    assert_eq!(code, 0, "{err}");
+    out.to_path_buf()
+}
+
 #[test]
 fn png_plates_are_decoded_from_srgb_and_png_outputs_encoded_unless_raw() {
     let d = tmp("srgb");
@@ -491,15 +508,7 @@ fn png_plates_are_decoded_from_srgb_and_png_outputs_encoded_unless_raw() {
     ::image::RgbaImage::from_pixel(24, 16, ::image::Rgba([128, 64, 255, 255]))
         .save(&png)
         .unwrap();
-    let warp = |out: &str, extra: &[&str]| {
-        let out = d.join(out);
-        let mut args = vec!["warp", "--line", IDENTITY, "--input", png.to_str().unwrap()];
-        args.extend_from_slice(&["--t", "0", "-o", out.to_str().unwrap()]);
-        args.extend_from_slice(extra);
-        let (code, err) = morphfx(&args);
-        assert_eq!(code, 0, "{err}");
-        out
-    };
+    let warp = |out: &str, extra: &[&str]| identity_warp(&png, &d.join(out), extra);
     // IEC 61966-2-1: code 128 is 0.21586 of linear light, 64 is 0.05127.
     let linear = io::read_as(&warp("linear.exr", &[]), io::Colour::Raw)
         .unwrap()
@@ -532,15 +541,7 @@ fn png_alpha_is_straight_in_the_file_and_premultiplied_in_the_render() {
     ::image::RgbaImage::from_pixel(24, 16, ::image::Rgba([128, 64, 255, 128]))
         .save(&png)
         .unwrap();
-    let warp = |out: &str, extra: &[&str]| {
-        let out = d.join(out);
-        let mut args = vec!["warp", "--line", IDENTITY, "--input", png.to_str().unwrap()];
-        args.extend_from_slice(&["--t", "0", "-o", out.to_str().unwrap()]);
-        args.extend_from_slice(extra);
-        let (code, err) = morphfx(&args);
-        assert_eq!(code, 0, "{err}");
-        out
-    };
+    let warp = |out: &str, extra: &[&str]| identity_warp(&png, &d.join(out), extra);
     let exr = io::read_as(&warp("linear.exr", &[]), io::Colour::Raw)
         .unwrap()
         .image;

@@ -96,6 +96,14 @@ impl Prepared {
     }
 }
 
+/// What the command line itself says, read before any plate.
+struct Command {
+    scene: Option<Scene>,
+    lines: Vec<LineKey>,
+    frames: Vec<i64>,
+    params: Vec<ParamSetting>,
+}
+
 pub struct Job {
     pub plugin: &'static str,
     pub context: &'static str,
@@ -122,6 +130,39 @@ impl Job {
     /// lines, the frames and every input's header.
     pub fn prepare(&self) -> Result<Prepared, HostError> {
         let c = &self.common;
+        let Command {
+            scene,
+            lines,
+            frames,
+            params,
+        } = self.command()?;
+        let plates: Vec<(String, Arc<Plates>)> = self
+            .sources
+            .iter()
+            .map(|(clip, p)| (clip.clone(), Plates::new(p, c.colour())))
+            .collect();
+        let inputs = check_inputs(&plates, &frames)?;
+        let mattes: Vec<(String, Arc<Plates>)> = self
+            .mattes
+            .iter()
+            .map(|(clip, p)| (clip.clone(), Plates::matte(p, c.colour())))
+            .collect();
+        check_mattes(&mattes, &frames)?;
+        Ok(Prepared {
+            scene,
+            lines,
+            frames,
+            plates,
+            mattes,
+            params,
+            inputs,
+        })
+    }
+
+    /// The command line's own words read and checked: the scene, the
+    /// lines, `--t`, the frames against the outputs, the `--param`s.
+    fn command(&self) -> Result<Command, HostError> {
+        let c = &self.common;
         let scene = read_scene(c.scene.as_deref())?;
         let lines = c
             .line
@@ -135,31 +176,16 @@ impl Job {
         }
         let frames = self.frames(scene.as_ref(), &lines)?;
         self.check_outputs(&frames)?;
-        let plates: Vec<(String, Arc<Plates>)> = self
-            .sources
-            .iter()
-            .map(|(clip, p)| (clip.clone(), Plates::new(p, c.colour())))
-            .collect();
-        let inputs = check_inputs(&plates, &frames)?;
-        let mattes: Vec<(String, Arc<Plates>)> = self
-            .mattes
-            .iter()
-            .map(|(clip, p)| (clip.clone(), Plates::matte(p, c.colour())))
-            .collect();
-        check_mattes(&mattes, &frames)?;
         let params = c
             .param
             .iter()
             .map(|spec| ParamSetting::parse(spec))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Prepared {
+        Ok(Command {
             scene,
             lines,
             frames,
-            plates,
-            mattes,
             params,
-            inputs,
         })
     }
 
@@ -190,20 +216,7 @@ impl Job {
     /// `--param` against the node the bundle makes. The plates are not read
     /// here (a worker may see other mounts); each chunk checks them first.
     pub fn check_submission(&self, bundle_path: &Path) -> Result<(), HostError> {
-        let c = &self.common;
-        let scene = read_scene(c.scene.as_deref())?;
-        let lines = c
-            .line
-            .iter()
-            .map(|spec| LineKey::parse(spec))
-            .collect::<Result<Vec<_>, _>>()?;
-        let frames = self.frames(scene.as_ref(), &lines)?;
-        self.check_outputs(&frames)?;
-        let params = c
-            .param
-            .iter()
-            .map(|spec| ParamSetting::parse(spec))
-            .collect::<Result<Vec<_>, _>>()?;
+        let Command { scene, params, .. } = self.command()?;
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;
         for p in &params {
