@@ -175,3 +175,106 @@ fn every_documented_command_runs_and_the_pictures_are_what_it_draws() {
         );
     }
 }
+
+/// The default a user-guide param row states: `(default V`, `` `V` (default``,
+/// `` `V` (…, default`` or `V (default)`; `off`/`on` as booleans.
+fn stated_default(text: &str) -> Option<String> {
+    let word = |s: &str| {
+        let v = s.trim().to_string();
+        match v.as_str() {
+            "off" => "false".to_string(),
+            "on" => "true".to_string(),
+            _ => v,
+        }
+    };
+    if let Some(k) = text.find("(default ") {
+        let rest = &text[k + "(default ".len()..];
+        let end = rest
+            .find([';', ':', ')', ','])
+            .unwrap_or(rest.len())
+            .min(rest.find(" each").unwrap_or(rest.len()));
+        return Some(word(&rest[..end]));
+    }
+    let k = text.find("default")?;
+    let before = &text[..k];
+    // The last `code` before it, if the default's parenthesis follows it.
+    if let Some(close) = before.rfind("` (") {
+        let open = before[..close].rfind('`')?;
+        return Some(word(&before[open + 1..close]));
+    }
+    let before = before.strip_suffix('(')?.trim_end();
+    Some(word(before.rsplit(' ').next()?))
+}
+
+#[test]
+fn every_default_the_user_guide_states_is_the_nodes() {
+    use morphfx_harness::host::props::PropertySet;
+    use openfx::sys::generic::core::kOfxPropLabel;
+    use openfx::sys::image_effect_v1::param::*;
+    let guide = std::fs::read_to_string(root().join("docs/user-guide.md")).unwrap();
+    let params = guide.split("## Params").nth(1).unwrap();
+    let params = params.split("\n## ").next().unwrap();
+    let inst = common::bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let declared = |label: &str| -> Option<(String, &PropertySet)> {
+        // Groups share labels with params (Transition › Transition): only
+        // params that hold a value count.
+        inst.param_names().into_iter().find_map(|(id, kind)| {
+            let p = inst.param_props(&id)?;
+            let holds = !matches!(
+                kind.as_str(),
+                "OfxParamTypeGroup" | "OfxParamTypePushButton" | "OfxParamTypePage"
+            );
+            (holds && p.str(kOfxPropLabel).as_deref() == Some(label)).then_some((id, p))
+        })
+    };
+    let mut checked = 0;
+    for row in params.lines().filter(|l| l.starts_with("| **")) {
+        let name = row[4..].split("**").next().unwrap();
+        let text = row.split(" | ").nth(1).unwrap_or("");
+        let Some(stated) = stated_default(text) else {
+            continue;
+        };
+        let last = name.rsplit(" › ").next().unwrap();
+        for label in last.split(" / ") {
+            let (id, p) = declared(label).unwrap_or_else(|| panic!("no param labelled {label}"));
+            let kind = p.str(kOfxParamPropType).unwrap_or_default();
+            let actual = match kind.as_str() {
+                "OfxParamTypeChoice" => {
+                    let k = p.ints(kOfxParamPropDefault)[0] as usize;
+                    p.strs(kOfxParamPropChoiceOption)[k].clone()
+                }
+                "OfxParamTypeBoolean" => (p.ints(kOfxParamPropDefault)[0] == 1).to_string(),
+                "OfxParamTypeInteger" => p.ints(kOfxParamPropDefault)[0].to_string(),
+                _ => p.doubles(kOfxParamPropDefault)[0].to_string(),
+            };
+            let same = match (stated.parse::<f64>(), actual.parse::<f64>()) {
+                (Ok(s), Ok(a)) => (s - a).abs() < 1e-12,
+                _ => stated == actual,
+            };
+            assert!(
+                same,
+                "{label} ({id}): the guide says {stated}, the node {actual}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 18, "only {checked} defaults found in the guide");
+}
+
+#[test]
+fn defaults_are_read_from_each_way_the_guide_words_them() {
+    for (text, want) in [
+        ("in pixels (default 0.05).", "0.05"),
+        ("coefficients (default 1 each).", "1"),
+        ("in order (default off): about", "false"),
+        ("`adaptive` (default) is within", "adaptive"),
+        ("`two-pass` (default; the classic", "two-pass"),
+        ("`clamp` (edge pixels, default — no", "clamp"),
+        ("quads per side; 0 (default) picks", "0"),
+    ] {
+        assert_eq!(stated_default(text).as_deref(), Some(want), "{text}");
+    }
+    assert_eq!(stated_default("no such word here"), None);
+}
