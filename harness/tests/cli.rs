@@ -736,3 +736,53 @@ fn bench_keeps_its_plates_only_under_the_folder_it_is_given() {
     assert!(d.join("kept/plates/a.0002.exr").is_file());
     assert!(d.join("kept/morph.0002.exr").is_file());
 }
+
+/// The folds view's PNG holds the morph in R, G and B (straight colour, as
+/// a host's PNG writer stores it), its alpha the folds: the picture is in
+/// the file even where an image viewer that composites alpha shows none.
+#[test]
+fn a_folds_png_holds_the_morph_in_its_colour_channels() {
+    let d = tmp("folds-png");
+    // Opaque plates in [0, 1]: the morph's PNG is its colour as it is.
+    let texture = |seed: f64| {
+        move |p: morphfx::geom::Vec2| {
+            let v = |c: f64| (0.5 + 0.4 * (p.x * 0.3 + p.y * 0.17 + seed + c).sin()) as f32;
+            [v(0.0), v(1.0), v(2.0)]
+        }
+    };
+    let (a, b) = (d.join("a.exr"), d.join("b.exr"));
+    common::colour_plate(&a, 64, 48, texture(0.0));
+    common::colour_plate(&b, 64, 48, texture(1.3));
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
+    let scene = d.join("s.morph.json");
+    let render = |view: &str, out: &str| {
+        let out = d.join(out);
+        let (code, err) = morphfx(&[
+            "morph",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--a",
+            a,
+            "--b",
+            b,
+            "--t",
+            "0.5",
+            "--view",
+            view,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        ::image::open(out).unwrap().to_rgba8()
+    };
+    let (folds, morph) = (render("folds", "folds.png"), render("morph", "morph.png"));
+    let mut unfolded = 0;
+    for (f, m) in folds.pixels().zip(morph.pixels()) {
+        if f.0[3] == 0 {
+            unfolded += 1;
+            assert_eq!(f.0[..3], m.0[..3], "the morph's colour, alpha 0");
+        }
+    }
+    assert!(unfolded > 64 * 48 / 2, "{unfolded} pixels without folds");
+}
