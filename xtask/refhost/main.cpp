@@ -616,6 +616,40 @@ void checkStraight(IE::ImageEffectPlugin &plugin, const std::string &context,
          kOfxImageUnPreMultiplied + "'");
 }
 
+/// RGB sources, as a host offers an RGB plate: the library gives the output
+/// the sources' components (RGB) unless the plugin asks for others. The
+/// ghost and folds views carry their measure in alpha, so with them the
+/// node must ask for RGBA; with the morph (or warped) view, RGB stands.
+void checkRgbaViews(IE::ImageEffectPlugin &plugin, const std::string &context,
+                    const Where &where) {
+  const Where w = where.with(context).with("RGB sources");
+  std::unique_ptr<IE::Instance> made(plugin.createInstance(context, nullptr));
+  auto *fx = dynamic_cast<Effect *>(made.get());
+  if (!fx) return fail(w.text + ": no instance (describe in context failed)");
+  fx->sourceComponents = kOfxImageComponentRGB;
+  expectOk(fx->createInstanceAction(), w, "createInstance");
+  auto *view = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("view"));
+  if (!view) return fail(w.text + ": no view choice");
+  const int views = choiceCount(*fx, "view");
+  int asked = 0;
+  for (int v = 0; v < views; ++v) {
+    const std::string name =
+        view->getProperties().getStringProperty(kOfxParamPropChoiceOption, v);
+    const bool alpha = name == "ghost" || name == "folds";
+    if (!alpha && v != 0) continue;  // the default view stands for the rest
+    view->set(v);
+    if (!fx->getClipPreferences()) {
+      fail(w.text + ", view " + name + ": getClipPreferences failed");
+      continue;
+    }
+    const std::string want = alpha ? kOfxImageComponentRGBA : kOfxImageComponentRGB;
+    const std::string got = fx->getClip(kOfxImageEffectOutputClipName)->getComponents();
+    if (got != want) fail(w.text + ", view " + name + ": output " + got + ", not " + want);
+    asked += alpha;
+  }
+  if (asked == 0) fail(w.text + ": no ghost or folds view offered");
+}
+
 /// A node just made, nothing connected, as Natron asks of it at once:
 /// region of definition, clip preferences, regions of interest, frames
 /// needed and identity each answer without a failure status, and nothing
@@ -732,6 +766,7 @@ int main(int argc, char **argv) {
       }
       checkUnconnected(*plugin, context, {node.id});
       checkStraight(*plugin, context, {node.id});
+      checkRgbaViews(*plugin, context, {node.id});
       for (const char *depth : {kOfxBitDepthFloat, kOfxBitDepthByte}) {
         checkContext(*plugin, context, depth, {node.id});
         ++checked;

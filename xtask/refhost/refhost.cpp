@@ -365,8 +365,7 @@ const std::string &Clip::getUnmappedBitDepth() const {
   return effect_->sourceDepth;
 }
 const std::string &Clip::getUnmappedComponents() const {
-  static const std::string rgba = kOfxImageComponentRGBA;
-  return rgba;
+  return effect_->sourceComponents;
 }
 const std::string &Clip::getPremult() const {
   static const std::string premult = kOfxImagePreMultiplied;

@@ -83,6 +83,8 @@ class Effect : public OFX::Host::ImageEffect::Instance {
   bool timingConnected = false;
   /// Whether the input clips' colour is straight (not premultiplied).
   bool straight = false;
+  /// The components the input clips come in (before clip preferences).
+  std::string sourceComponents = kOfxImageComponentRGBA;
   /// The persistent message the plugin last set (empty once cleared).
   std::string persistentError;
 
