@@ -6,7 +6,11 @@
 // drives each node's overlay (draw, and a drag that moves a line; drawn in
 // an offscreen OpenGL context too, where Mesa's EGL is there). Exit
 // status 0 when every check passed, 1 with the failures listed otherwise.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -524,6 +528,25 @@ void checkOverlayShapes(Effect &fx, const Where &w) {
   text->get(after);
   if (!has("\"type\": \"point\"") || !has("\"a\": [[85, 55]]") || !has("\"b\": [[85, 55]]"))
     fail(w.text + ": the point tool's click at (85, 55) left Scene Text " + after);
+  // With a Scene File in use its shapes are read-only: the click is
+  // refused with a warning on the node, not an error (an error would mark
+  // a node that renders fine as failed, Natron's ERROR badge).
+  auto *file = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_file"));
+  if (!file) return fail(w.text + ": no scene_file param");
+  const std::string path = "/tmp/morphfx-refhost-" + std::to_string(getpid()) + ".morph.json";
+  std::ofstream(path) << after;
+  file->set(path.c_str());
+  fx.persistentError.clear();
+  fx.persistentType.clear();
+  const OfxPointD other = {20, 20};
+  expectOk(ov.penDownAction(0, scale, other, vp, 1), w, "overlay pen down (file in use)");
+  expectOk(ov.penUpAction(0, scale, other, vp, 0), w, "overlay pen up (file in use)");
+  if (fx.persistentError.find("Copy Scene Into Node") == std::string::npos ||
+      fx.persistentType != kOfxMessageWarning)
+    fail(w.text + ": a click while Scene File is in use left '" + fx.persistentError +
+         "' as " + (fx.persistentType.empty() ? "nothing" : fx.persistentType));
+  file->set("");
+  std::remove(path.c_str());
   tool->set(0);
 }
 

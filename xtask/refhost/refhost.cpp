@@ -229,6 +229,7 @@ OfxStatus Effect::vmessage(const char *type, const char *, const char *fmt,
 OfxStatus Effect::setPersistentMessage(const char *type, const char *,
                                        const char *fmt, va_list args) {
   persistentError = format(fmt, args);
+  persistentType = type ? type : "";
   std::cerr << "refhost: persistent message (" << type
             << "): " << persistentError << std::endl;
   return kOfxStatOK;

@@ -85,8 +85,10 @@ class Effect : public OFX::Host::ImageEffect::Instance {
   bool straight = false;
   /// The components the input clips come in (before clip preferences).
   std::string sourceComponents = kOfxImageComponentRGBA;
-  /// The persistent message the plugin last set (empty once cleared).
+  /// The persistent message the plugin last set (empty once cleared), and
+  /// its type (kOfxMessageError, kOfxMessageWarning, ...).
   std::string persistentError;
+  std::string persistentType;
 
   const std::string &getDefaultOutputFielding() const override;
   OFX::Host::ImageEffect::ClipInstance *newClipInstance(
