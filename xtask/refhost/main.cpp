@@ -538,7 +538,7 @@ void checkOverlayShapes(Effect &fx, const Where &w) {
   file->set(path.c_str());
   fx.persistentError.clear();
   fx.persistentType.clear();
-  const OfxPointD other = {20, 20};
+  const OfxPointD other = {88, 8};  // clear of every line and shape
   expectOk(ov.penDownAction(0, scale, other, vp, 1), w, "overlay pen down (file in use)");
   expectOk(ov.penUpAction(0, scale, other, vp, 0), w, "overlay pen up (file in use)");
   if (fx.persistentError.find("Copy Scene Into Node") == std::string::npos ||
