@@ -521,6 +521,18 @@ void checkOverlayShapes(Effect &fx, const Where &w) {
       !has("[50, 48]"))
     fail(w.text + ": dragging the curve's middle A point to (52.5, 47) left Scene Text " +
          after);
+  // A host that refuses edit blocks (HostSupport's example host answers
+  // paramEditBegin with kOfxStatErrMissingHostFeature): the drag still
+  // edits, without an undo block.
+  fx.refuseEditBlocks = true;
+  const OfxPointD back = {50, 45};
+  expectOk(ov.penDownAction(0, scale, to, vp, 1), w, "overlay pen down (no edit blocks)");
+  expectOk(ov.penUpAction(0, scale, back, vp, 0), w, "overlay pen up (no edit blocks)");
+  fx.refuseEditBlocks = false;
+  text->get(after);
+  if (!has("[50, 45]") || has("[52.5, 47]"))
+    fail(w.text + ": with paramEditBegin refused, dragging the point back to (50, 45) left "
+         "Scene Text " + after);
   tool->set(1);  // point
   const OfxPointD empty = {85, 55};
   expectOk(ov.penDownAction(0, scale, empty, vp, 1), w, "overlay pen down (point tool)");

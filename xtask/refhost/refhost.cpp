@@ -274,7 +274,9 @@ P::Instance *Effect::newParam(const std::string &name, P::Descriptor &d) {
   return nullptr;
 }
 
-OfxStatus Effect::editBegin(const std::string &) { return kOfxStatOK; }
+OfxStatus Effect::editBegin(const std::string &) {
+  return refuseEditBlocks ? kOfxStatErrMissingHostFeature : kOfxStatOK;
+}
 OfxStatus Effect::editEnd() { return kOfxStatOK; }
 
 void Effect::paramChangedByPlugin(P::Instance *param) {

@@ -83,6 +83,9 @@ class Effect : public OFX::Host::ImageEffect::Instance {
   bool timingConnected = false;
   /// Whether the input clips' colour is straight (not premultiplied).
   bool straight = false;
+  /// Whether paramEditBegin is refused, as HostSupport's example host does
+  /// (kOfxStatErrMissingHostFeature).
+  bool refuseEditBlocks = false;
   /// The components the input clips come in (before clip preferences).
   std::string sourceComponents = kOfxImageComponentRGBA;
   /// The persistent message the plugin last set (empty once cleared), and

@@ -74,6 +74,8 @@ impl ParamSet {
         Params {
             set: *self,
             handles,
+            blocks_refused: Default::default(),
+            blocks_open: Default::default(),
         }
     }
 
@@ -332,6 +334,11 @@ struct Param {
 pub struct Params {
     set: ParamSet,
     handles: HashMap<String, Param>,
+    /// The host answered `paramEditBegin` with an error (the OpenFX
+    /// reference host's example does): edits go on without undo blocks.
+    blocks_refused: std::sync::atomic::AtomicBool,
+    /// Edit blocks opened and not yet closed.
+    blocks_open: std::sync::atomic::AtomicUsize,
 }
 
 // SAFETY: param handles are the host's, valid for the instance's life
@@ -356,6 +363,8 @@ impl Params {
                 suite: &NO_SUITE,
             },
             handles: HashMap::new(),
+            blocks_refused: Default::default(),
+            blocks_open: Default::default(),
         }
     }
 
@@ -539,42 +548,70 @@ impl Params {
 
     /// Opens an edit block that a later [`Params::end_edit`] closes: an
     /// overlay drag spans several actions and is still one undo step.
+    /// Opens an edit block, the host's one undo step, where it has them.
+    /// Undo blocks are a convenience: where the host has none, or refuses
+    /// to open one (the OpenFX reference host's example answers
+    /// `paramEditBegin` with an error), the edit goes on without, and the
+    /// refusal is said once.
     pub fn begin_edit(&self, name: &str) -> Outcome {
-        let Some(begin) = self.set.suite.paramEditBegin else {
-            return Ok(()); // a host without edit blocks: plain writes
-        };
-        let label = cstr(name);
-        // SAFETY: the instance's param set and a NUL-terminated label.
-        check(
-            unsafe { begin(self.set.set, label.as_ptr()) },
-            "paramEditBegin",
-        )
+        self.open_block(name);
+        Ok(())
     }
 
-    /// Closes the block [`Params::begin_edit`] opened.
+    /// Opens a block if the host has them and has not refused one; true
+    /// when a block is open.
+    fn open_block(&self, name: &str) -> bool {
+        use std::sync::atomic::Ordering;
+        let (Some(begin), Some(_)) = (self.set.suite.paramEditBegin, self.set.suite.paramEditEnd)
+        else {
+            return false;
+        };
+        if self.blocks_refused.load(Ordering::Acquire) {
+            return false;
+        }
+        let label = cstr(name);
+        // SAFETY: the instance's param set and a NUL-terminated label.
+        let status = unsafe { begin(self.set.set, label.as_ptr()) };
+        if status == kOfxStatOK {
+            self.blocks_open.fetch_add(1, Ordering::AcqRel);
+            return true;
+        }
+        if !self.blocks_refused.swap(true, Ordering::AcqRel) {
+            eprintln!(
+                "MorphFX: the host answered paramEditBegin with {}; edits are made without undo blocks",
+                super::status_name(status)
+            );
+        }
+        false
+    }
+
+    /// Closes the block [`Params::begin_edit`] opened (nothing where none
+    /// opened).
     pub fn end_edit(&self) -> Outcome {
+        use std::sync::atomic::Ordering;
         let Some(end) = self.set.suite.paramEditEnd else {
             return Ok(());
         };
+        let open = self.blocks_open.fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+            n.checked_sub(1)
+        });
+        if open.is_err() {
+            return Ok(()); // none opened: the host refused it, or has none
+        }
         // SAFETY: the instance's param set.
         check(unsafe { end(self.set.set) }, "paramEditEnd")
     }
 
     /// Runs `writes` inside one edit block (`paramEditBegin`/`paramEditEnd`):
     /// the host makes it one undo step. The block is closed whatever
-    /// `writes` returns.
+    /// `writes` returns. Without a block (see [`Params::begin_edit`]) the
+    /// writes are made all the same.
     pub fn edit_block<R>(&self, name: &str, writes: impl FnOnce() -> Outcome<R>) -> Outcome<R> {
-        let (begin, end) = match (self.set.suite.paramEditBegin, self.set.suite.paramEditEnd) {
-            (Some(b), Some(e)) => (b, e),
-            _ => return writes(), // a host without edit blocks: plain writes
-        };
-        let label = cstr(name);
-        // SAFETY: the instance's param set and a NUL-terminated label.
-        let status = unsafe { begin(self.set.set, label.as_ptr()) };
-        check(status, "paramEditBegin")?;
+        if !self.open_block(name) {
+            return writes();
+        }
         let result = writes();
-        // SAFETY: closes the block opened just above on the same set.
-        let closed = check(unsafe { end(self.set.set) }, "paramEditEnd");
+        let closed = self.end_edit();
         let value = result?;
         closed.map(|()| value)
     }
