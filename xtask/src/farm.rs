@@ -21,14 +21,14 @@ const OPENJD: [&str; 3] = [
 const FRAMES: &str = "1-12";
 const CHUNK: &str = "5";
 
-/// Runs the check; says SKIPPED (and why) when Python or PyPI cannot be
-/// had, and exits the test command on any failure.
-pub fn check(morphfx: &Path, bundle: &Path) {
+/// Runs the check; says SKIPPED (and why, which it returns) when Python or
+/// PyPI cannot be had, and exits the test command on any failure.
+pub fn check(morphfx: &Path, bundle: &Path) -> Option<String> {
     let openjd = match runtime() {
         Ok(openjd) => openjd,
         Err(why) => {
             println!("farm check (Open Job Description): SKIPPED ({why})");
-            return;
+            return Some(format!("the farm check ({why})"));
         }
     };
     let templates = root().join("farm").join("openjd");
@@ -91,6 +91,7 @@ pub fn check(morphfx: &Path, bundle: &Path) {
         OPENJD[0],
         METHODS.len()
     );
+    None
 }
 
 /// `morphfx job openjd` for a morph with an option the template carries as

@@ -172,8 +172,12 @@ fn main() {
             let b = bundle(args.iter().any(|a| a == "--release"));
             println!("bundle: {}", b.display());
         }
-        Some("refhost") => refhost::check(&bundle(false)),
-        Some("farm") => farm::check(&morphfx_binary(), &bundle(false)),
+        Some("refhost") => {
+            refhost::check(&bundle(false));
+        }
+        Some("farm") => {
+            farm::check(&morphfx_binary(), &bundle(false));
+        }
         Some("demo") => {
             let b = bundle(true);
             let status = morphfx(true, &b)
@@ -201,18 +205,80 @@ fn test(cargo_args: &[String]) {
     let b = build_for_tests();
     // Tests find the bundle through this variable.
     unsafe_env("MORPHFX_BUNDLE", &b);
-    ensure_openimageio();
+    let mut skipped = ensure_tools();
     let mut run = vec!["test", "--workspace"];
     run.extend(cargo_args.iter().map(String::as_str));
     cargo(&run);
     core_tests_fast();
     release_concurrency(&b);
     docs();
-    refhost::check(&b);
+    skipped.extend(refhost::check(&b));
     let morphfx = dev_morphfx();
-    farm::check(&morphfx, &b);
+    skipped.extend(farm::check(&morphfx, &b));
     cmake_install_check(&morphfx);
     morphfx_install_check(&b);
+    summary(&skipped);
+}
+
+/// The outside tools tests run, installed where this machine can; each
+/// one present is required of its test (`MORPHFX_REQUIRE_TOOLS`), so a
+/// test cannot skip what is there. What cannot be had is returned, for
+/// the summary.
+fn ensure_tools() -> Vec<String> {
+    let tools: [(&str, &[&str], &[&str], &str); 3] = [
+        (
+            "oiiotool",
+            &["--version"],
+            &["openimageio-tools"],
+            "the EXR cross-check",
+        ),
+        (
+            "qemu-x86_64",
+            &["--version"],
+            &["qemu-user"],
+            "the emulated-CPU run",
+        ),
+        (
+            "cmake",
+            &["--version"],
+            &["cmake"],
+            "the CMake install check",
+        ),
+    ];
+    let mut present = Vec::new();
+    let mut skipped = Vec::new();
+    for (tool, probe, packages, what) in tools {
+        if tools::runs(tool, probe)
+            || (tools::apt_install(packages, what) && tools::runs(tool, probe))
+        {
+            present.push(tool);
+        } else {
+            println!("note: {tool} unavailable; {what} will be skipped");
+            skipped.push(format!("{what} ({tool} not installed)"));
+        }
+    }
+    // SAFETY: single-threaded here, before cargo is spawned.
+    unsafe { std::env::set_var("MORPHFX_REQUIRE_TOOLS", present.join(",")) };
+    skipped
+}
+
+/// The last lines of a test run: every check that did not run, and why.
+/// Under `CI=true` a check skipped on a machine that could have installed
+/// its tool (root, apt-get) fails the run: a green run there has run
+/// everything.
+fn summary(skipped: &[String]) {
+    if skipped.is_empty() {
+        println!("skipped: nothing; every check ran");
+        return;
+    }
+    println!("skipped:");
+    for s in skipped {
+        println!("  - {s}");
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") && tools::can_apt() {
+        eprintln!("under CI=true on a machine that installs with apt-get, nothing may be skipped");
+        exit(1);
+    }
 }
 
 /// Builds what the tests run, each in one cargo call per CPU level, and
@@ -321,17 +387,6 @@ fn docs() {
     println!("cargo doc: documentation builds with no warnings");
 }
 
-/// The EXR cross-check reads our outputs with OpenImageIO's `oiiotool`;
-/// install it when missing and this machine can.
-fn ensure_openimageio() {
-    if tools::runs("oiiotool", &["--version"])
-        || tools::apt_install(&["openimageio-tools"], "the EXR cross-check")
-    {
-        return;
-    }
-    println!("note: oiiotool unavailable; the OpenImageIO cross-check will be skipped");
-}
-
 /// `cmake -S . -B build && cmake --build build && cmake --install build --prefix P`
 /// must leave a bundle under `P/OFX/Plugins` that a host can load: checked by
 /// listing its plugins through the C ABI with `morphfx` (the dev binary the
@@ -340,6 +395,7 @@ fn ensure_openimageio() {
 /// release plugins afresh in the build folder.
 fn cmake_install_check(morphfx: &Path) {
     if !tools::runs("cmake", &["--version"]) {
+        // ensure_tools puts it in the summary.
         println!("cmake install check: skipped (cmake is not installed)");
         return;
     }

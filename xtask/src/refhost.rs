@@ -13,8 +13,9 @@ use crate::{root, target_dir, tools};
 const OPENFX_SYS: &str = "openfx-sys-0.1.0";
 
 /// Builds and runs the reference host on `bundle`; exits the test command on
-/// any failure, and says plainly when the check cannot run here.
-pub fn check(bundle: &Path) {
+/// any failure, and says plainly when the check (or a part of it) cannot
+/// run here: what was skipped, for the test command's summary.
+pub fn check(bundle: &Path) -> Vec<String> {
     let built = openfx_tree().and_then(|tree| {
         toolchain()?;
         offscreen_gl();
@@ -24,7 +25,7 @@ pub fn check(bundle: &Path) {
         Ok(exe) => exe,
         Err(Skip(why)) => {
             println!("reference host check: SKIPPED ({why})");
-            return;
+            return vec![format!("the reference host check ({why})")];
         }
     };
     let folder = bundle.parent().expect("the bundle lies in a folder");
@@ -38,8 +39,13 @@ pub fn check(bundle: &Path) {
         eprintln!("reference host check FAILED ({})", out.status);
         exit(1);
     }
-    for skipped in text.lines().filter(|l| l.contains("SKIPPED")) {
-        println!("{skipped}");
+    let skipped: Vec<String> = text
+        .lines()
+        .filter(|l| l.contains("SKIPPED"))
+        .map(str::to_owned)
+        .collect();
+    for line in &skipped {
+        println!("{line}");
     }
     // Our own last line: the plugin may say things on stderr after it.
     let summary = String::from_utf8_lossy(&out.stdout)
@@ -49,6 +55,7 @@ pub fn check(bundle: &Path) {
         .unwrap_or_default()
         .to_owned();
     println!("reference host check (OpenFX HostSupport): {summary}");
+    skipped
 }
 
 /// Why the check could not run on this machine.

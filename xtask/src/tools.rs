@@ -12,14 +12,20 @@ pub fn runs(tool: &str, args: &[&str]) -> bool {
         .is_ok_and(|s| s.success())
 }
 
-/// Installs `packages` with apt-get when this machine can (root, Debian
-/// family), saying why; false when it cannot or the install failed.
-pub fn apt_install(packages: &[&str], why: &str) -> bool {
+/// Whether this machine installs packages with apt-get (root, Debian
+/// family).
+pub fn can_apt() -> bool {
     let is_root = Command::new("id")
         .arg("-u")
         .output()
         .is_ok_and(|o| o.stdout.starts_with(b"0"));
-    if !is_root || !runs("apt-get", &["--version"]) {
+    is_root && runs("apt-get", &["--version"])
+}
+
+/// Installs `packages` with apt-get when this machine can, saying why;
+/// false when it cannot or the install failed.
+pub fn apt_install(packages: &[&str], why: &str) -> bool {
+    if !can_apt() {
         return false;
     }
     println!("installing {} for {why} (apt-get)...", packages.join(" "));

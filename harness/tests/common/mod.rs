@@ -109,6 +109,15 @@ impl AsRef<std::ffi::OsStr> for Scratch {
     }
 }
 
+/// Whether a test may skip for want of `tool`: not when `cargo xtask test`
+/// found or installed it (`MORPHFX_REQUIRE_TOOLS`), where its absence from
+/// the test's view is a failure, not a skip.
+#[allow(dead_code)] // only tests that use an outside tool ask
+pub fn may_skip_without(tool: &str) -> bool {
+    let required = std::env::var("MORPHFX_REQUIRE_TOOLS").unwrap_or_default();
+    !required.split(',').any(|t| t == tool)
+}
+
 /// `morphfx --bundle <the built bundle> ARGS...`, run to completion.
 #[allow(dead_code)] // not every test file runs the binary
 pub fn run_morphfx(args: &[&str]) -> Output {

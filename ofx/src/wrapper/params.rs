@@ -592,9 +592,9 @@ impl Params {
         let Some(end) = self.set.suite.paramEditEnd else {
             return Ok(());
         };
-        let open = self.blocks_open.fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
-            n.checked_sub(1)
-        });
+        let open = self
+            .blocks_open
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| n.checked_sub(1));
         if open.is_err() {
             return Ok(()); // none opened: the host refused it, or has none
         }
