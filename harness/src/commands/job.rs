@@ -219,13 +219,7 @@ impl Job {
         let Command { scene, params, .. } = self.command()?;
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;
-        for p in &params {
-            p.apply(&inst)?;
-        }
-        if let Some(scene) = &scene {
-            refuse_settings_the_scene_sets(&inst, scene, &params)?;
-        }
-        Ok(())
+        apply_params(&inst, scene.as_ref(), &params)
     }
 
     pub fn run(&self, bundle_path: &Path) -> Result<(), HostError> {
@@ -281,12 +275,7 @@ impl Job {
             inst.set_double("progress", &[t], None)?;
             inst.set_int("use_scene_progress", 0)?;
         }
-        for p in &job.params {
-            p.apply(inst)?;
-        }
-        if let Some(scene) = &job.scene {
-            refuse_settings_the_scene_sets(inst, scene, &job.params)?;
-        }
+        apply_params(inst, job.scene.as_ref(), &job.params)?;
         inst.set_project(size.0 as f64, size.1 as f64);
         for (clip, p) in job.plates.iter().chain(&job.mattes) {
             inst.connect(clip, p.clone())?;
@@ -406,6 +395,22 @@ impl Job {
             writing.as_secs_f64()
         ));
         Ok(())
+    }
+}
+
+/// Every `--param` set on `inst` as a host would, and none that `scene`
+/// would silently override.
+fn apply_params(
+    inst: &Instance<'_>,
+    scene: Option<&Scene>,
+    params: &[ParamSetting],
+) -> Result<(), HostError> {
+    for p in params {
+        p.apply(inst)?;
+    }
+    match scene {
+        Some(scene) => refuse_settings_the_scene_sets(inst, scene, params),
+        None => Ok(()),
     }
 }
 
