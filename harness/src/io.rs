@@ -279,11 +279,17 @@ fn read_exr_meta(path: &Path) -> std::result::Result<exr::meta::MetaData, HostEr
     } else {
         0
     };
-    let place = match meta.headers[0].blocks {
+    let place = |h: &exr::meta::header::Header| match h.blocks {
         exr::meta::BlockDescription::ScanLines => 4,
         exr::meta::BlockDescription::Tiles(_) => 16,
     };
-    let lead = part + place;
+    let first = place(&meta.headers[0]);
+    if meta.headers.iter().any(|h| place(h) != first) {
+        // Parts of both kinds: which one the last chunk belongs to decides
+        // where its size lies; the decoder checks it.
+        return Ok(meta);
+    }
+    let lead = part + first;
     // Where the pixels could reach at most, had nothing been cut.
     let room: u64 = meta
         .headers
