@@ -3,7 +3,7 @@
 //! through the binary. The bundles are run by the Open Job Description
 //! runtime itself in `cargo xtask test` (xtask/src/farm.rs).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

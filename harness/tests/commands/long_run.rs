@@ -2,7 +2,7 @@
 //! of 64 open files, its peak resident size within a few MB of a 100-frame
 //! run's.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

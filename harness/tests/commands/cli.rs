@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use std::process::Command;
 
 use morphfx::geom::RectI;

@@ -3,7 +3,7 @@
 //! name; the run names the file it could not write and exits 2 (an
 //! interrupted one also says which frames are whole).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::{Command, Stdio};

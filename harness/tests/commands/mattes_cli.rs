@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 
 use morphfx::geom::RectI;
 use morphfx::image::Image;

@@ -12,7 +12,7 @@
 //! `docs/images` instead of comparing: how they are remade after a change
 //! to the overlay.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use std::process::Command;
 
 use morphfx::geom::RectI;
