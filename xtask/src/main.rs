@@ -288,20 +288,6 @@ fn skips_fail(skipped: &[String], ci: bool, can_apt: bool) -> bool {
     !skipped.is_empty() && ci && can_apt
 }
 
-#[cfg(test)]
-mod tests {
-    use super::skips_fail;
-
-    #[test]
-    fn a_skipped_check_fails_only_under_ci_where_apt_could_have_helped() {
-        let one = ["the EXR cross-check (oiiotool not installed)".to_string()];
-        assert!(skips_fail(&one, true, true));
-        assert!(!skips_fail(&one, false, true));
-        assert!(!skips_fail(&one, true, false));
-        assert!(!skips_fail(&[], true, true));
-    }
-}
-
 /// Builds what the tests run, each in one cargo call per CPU level, and
 /// lays out the dev bundle. One call per level matters for time: cargo
 /// unifies features over the packages and targets of a call, and the test
@@ -519,4 +505,18 @@ fn morphfx_install_check(bundle: &Path) {
 fn unsafe_env(key: &str, value: &Path) {
     // SAFETY: single-threaded here: setting the variable before spawning cargo is sound.
     unsafe { std::env::set_var(key, value) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::skips_fail;
+
+    #[test]
+    fn a_skipped_check_fails_only_under_ci_where_apt_could_have_helped() {
+        let one = ["the EXR cross-check (oiiotool not installed)".to_string()];
+        assert!(skips_fail(&one, true, true));
+        assert!(!skips_fail(&one, false, true));
+        assert!(!skips_fail(&one, true, false));
+        assert!(!skips_fail(&[], true, true));
+    }
 }
