@@ -13,4 +13,5 @@ pub mod progress;
 pub mod raster;
 pub mod sequence;
 pub mod snap;
+pub mod sync;
 pub mod track;

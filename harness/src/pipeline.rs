@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 
 use crate::host::HostError;
 use crate::io::{self, OutputFormat, Plate};
+use crate::sync::Locked;
 
 /// One frame being read on another thread, ahead of need.
 pub struct ReadAhead<T> {
@@ -74,12 +75,12 @@ impl WriteBehind {
         let writer = std::thread::spawn(move || {
             let mut busy = Duration::ZERO;
             for (path, plate, format) in jobs {
-                if seen.lock().unwrap_or_else(|e| e.into_inner()).is_some() {
+                if seen.locked().is_some() {
                     continue; // drain: nothing more is written after a failure
                 }
                 let started = Instant::now();
                 if let Err(e) = io::write_as(&path, &plate, format) {
-                    *seen.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+                    *seen.locked() = Some(e);
                 }
                 busy += started.elapsed();
             }
@@ -93,10 +94,7 @@ impl WriteBehind {
     }
 
     fn failure(&self) -> Option<HostError> {
-        self.failed
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone()
+        self.failed.locked().clone()
     }
 
     /// Queues a frame (waiting while the queue is full); an earlier frame's

@@ -16,6 +16,8 @@ use std::sync::{Arc, Mutex, OnceLock, Weak};
 use morphfx::image::WarpMap;
 use morphfx::warp::auto::Correspondence;
 
+use crate::sync::Locked;
+
 /// Default process-wide budget, MiB (a 1080p map is 16 MiB).
 pub const DEFAULT_BUDGET_MB: usize = 256;
 
@@ -101,12 +103,12 @@ impl<T> Entries<T> {
 
 impl<T: Send + Sync> Shrink for Entries<T> {
     fn oldest(&self, keep: Option<&Key>) -> Option<u64> {
-        let entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let entries = self.0.locked();
         Self::oldest_of(&entries, keep).map(|i| entries[i].last_use)
     }
 
     fn evict_oldest(&self, keep: Option<&Key>) -> usize {
-        let mut entries = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut entries = self.0.locked();
         match Self::oldest_of(&entries, keep) {
             Some(i) => entries.swap_remove(i).bytes,
             None => 0,
@@ -144,7 +146,7 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
     pub fn new() -> Self {
         let entries = Arc::new(Entries(Mutex::new(Vec::new())));
         let weak: Weak<dyn Shrink> = Arc::downgrade(&entries) as Weak<dyn Shrink>;
-        let mut caches = CACHES.lock().unwrap_or_else(|e| e.into_inner());
+        let mut caches = CACHES.locked();
         caches.retain(|c| c.strong_count() > 0);
         caches.push(weak);
         Cache { entries }
@@ -157,7 +159,7 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
     ) -> Result<Arc<T>, E> {
         let now = CLOCK.fetch_add(1, Ordering::Relaxed);
         let slot = {
-            let mut entries = self.lock();
+            let mut entries = self.entries();
             match entries.iter_mut().find(|e| e.key == key) {
                 Some(e) => {
                     e.last_use = now;
@@ -176,7 +178,7 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
             }
         };
         // Per-entry lock: threads wanting the same map wait here for one computation.
-        let mut value = slot.lock().unwrap_or_else(|e| e.into_inner());
+        let mut value = slot.locked();
         if let Some(map) = value.as_ref() {
             return Ok(map.clone());
         }
@@ -187,13 +189,13 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
         Ok(map)
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Entry<T>>> {
-        self.entries.0.lock().unwrap_or_else(|e| e.into_inner())
+    fn entries(&self) -> std::sync::MutexGuard<'_, Vec<Entry<T>>> {
+        self.entries.0.locked()
     }
 
     fn account(&self, key: &Key, bytes: usize) {
         {
-            let mut entries = self.lock();
+            let mut entries = self.entries();
             // Evicted while it was computed: it is not held, so not counted.
             let Some(e) = entries.iter_mut().find(|e| e.key == *key) else {
                 return;
@@ -207,7 +209,7 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
     /// Evicts the least recently used entries of the whole process (never
     /// `keep`, the value just made) until the total fits the budget.
     fn shrink(&self, keep: &Key) {
-        let caches = CACHES.lock().unwrap_or_else(|e| e.into_inner());
+        let caches = CACHES.locked();
         let me: *const Entries<T> = Arc::as_ptr(&self.entries);
         while USED.load(Ordering::Acquire) > budget() {
             let oldest = caches
@@ -229,13 +231,13 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
     }
 
     pub fn clear(&self) {
-        let freed: usize = self.lock().drain(..).map(|e| e.bytes).sum();
+        let freed: usize = self.entries().drain(..).map(|e| e.bytes).sum();
         USED.fetch_sub(freed, Ordering::AcqRel);
     }
 
     #[cfg(test)]
     pub fn bytes(&self) -> usize {
-        self.lock().iter().map(|e| e.bytes).sum()
+        self.entries().iter().map(|e| e.bytes).sum()
     }
 }
 
@@ -243,7 +245,7 @@ impl<T> Drop for Cache<T> {
     /// Gives its bytes back; drained under the lock eviction takes, so an
     /// entry is never counted off twice.
     fn drop(&mut self) {
-        let mut entries = self.entries.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut entries = self.entries.0.locked();
         let freed: usize = entries.drain(..).map(|e| e.bytes).sum();
         USED.fetch_sub(freed, Ordering::AcqRel);
     }

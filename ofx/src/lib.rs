@@ -8,6 +8,7 @@
 
 mod cache;
 mod nodes;
+mod sync;
 mod wrapper;
 
 wrapper::export!(nodes::Morph, nodes::Warp);

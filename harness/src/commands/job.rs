@@ -17,6 +17,7 @@ use crate::io::{self, ExrPrecision, Plate};
 use crate::pipeline::WriteBehind;
 use crate::progress::Progress;
 use crate::sequence::{frame_path, is_sequence, parse_frames};
+use crate::sync::Locked;
 
 pub const MORPH_ID: &str = "net.morphfx.Morph";
 pub const WARP_ID: &str = "net.morphfx.Warp";
@@ -314,7 +315,7 @@ impl Job {
         // result cannot be trusted to say so.
         let read_failure = |f: i64| {
             plates.iter().chain(&job.mattes).find_map(|(clip, p)| {
-                let e = p.error.lock().unwrap_or_else(|p| p.into_inner()).take()?;
+                let e = p.error.locked().take()?;
                 let frame = if is_sequence(&p.pattern) {
                     format!(" (frame {f})")
                 } else {
@@ -384,10 +385,7 @@ impl Job {
         inst.end_sequence(range.0, range.1)?;
         // Reading and writing run on their own threads beside the render;
         // a render that had to wait for its plates counts that wait.
-        let reading: Duration = plates
-            .iter()
-            .map(|(_, p)| *p.read_time.lock().unwrap_or_else(|e| e.into_inner()))
-            .sum();
+        let reading: Duration = plates.iter().map(|(_, p)| *p.read_time.locked()).sum();
         progress.done(&format!(
             "render {:.2} s (waits for plates included); alongside it, read {:.2} s, write {:.2} s",
             rendering.as_secs_f64(),

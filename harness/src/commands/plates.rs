@@ -8,6 +8,7 @@ use crate::host::{frame, Frame, FrameSource, HostError};
 use crate::io::{self};
 use crate::pipeline::ReadAhead;
 use crate::sequence::{frame_path, is_sequence};
+use crate::sync::Locked;
 
 /// A frame read from disk: its number, pixels and display-window size.
 pub type CachedPlate = (i64, Arc<Frame>, (usize, usize));
@@ -69,20 +70,20 @@ impl Plates {
         } else {
             plate.image
         };
-        *self.read_time.lock().unwrap_or_else(|e| e.into_inner()) += started.elapsed();
+        *self.read_time.locked() += started.elapsed();
         Ok((Arc::new(Frame::from_float_image(image)), plate.size))
     }
 
     /// Starts reading `frame` on another thread, unless it is at hand.
     pub fn read_ahead(self: &Arc<Self>, frame: i64) {
         let frame = self.file_frame(frame);
-        let mut ahead = lock(&self.ahead);
+        let mut ahead = self.ahead.locked();
         // A frame read ahead but never asked for (the plugin did not need
         // it) is kept once read, and makes room.
         if let Some((k, Ok(loaded))) = ahead.take_finished() {
             self.keep(k, &loaded);
         }
-        if !lock(&self.cache).iter().any(|(k, _, _)| *k == frame) {
+        if !self.cache.locked().iter().any(|(k, _, _)| *k == frame) {
             let me = self.clone();
             ahead.start(frame, move || me.load(frame));
         }
@@ -90,14 +91,14 @@ impl Plates {
 
     pub fn plate(&self, frame: i64) -> Result<Loaded, HostError> {
         let frame = self.file_frame(frame);
-        if let Some((_, f, size)) = lock(&self.cache).iter().find(|(k, _, _)| *k == frame) {
+        if let Some((_, f, size)) = self.cache.locked().iter().find(|(k, _, _)| *k == frame) {
             return Ok((f.clone(), *size));
         }
-        let pending = lock(&self.ahead).take(frame);
+        let pending = self.ahead.locked().take(frame);
         let loaded = pending
             .unwrap_or_else(|| self.load(frame))
             .inspect_err(|e| {
-                lock(&self.error).get_or_insert_with(|| e.clone());
+                self.error.locked().get_or_insert_with(|| e.clone());
             })?;
         self.keep(frame, &loaded);
         Ok(loaded)
@@ -106,14 +107,10 @@ impl Plates {
     /// Keeps `frame` at hand, and the next (read ahead); the others go: a
     /// sequence is rendered in order, each frame once.
     pub fn keep(&self, frame: i64, (f, size): &Loaded) {
-        let mut cache = lock(&self.cache);
+        let mut cache = self.cache.locked();
         cache.retain(|(k, _, _)| *k == frame + 1);
         cache.push((frame, f.clone(), *size));
     }
-}
-
-pub fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 impl FrameSource for Plates {

@@ -20,6 +20,7 @@ use super::effect::{Effect, Message};
 use super::error::{HostError, BAD_INPUT_ID};
 use super::props::PropertySet;
 use super::{effect, guard, interact_suites, misuse, params, props, services};
+use crate::sync::Locked;
 
 /// What a host offers beyond the basics.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -57,10 +58,7 @@ unsafe extern "C" fn fetch_suite(
         if misuse::withholds(name) {
             return std::ptr::null();
         }
-        let loaded = LOADED_HOSTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .contains(&(host as usize));
+        let loaded = LOADED_HOSTS.locked().contains(&(host as usize));
         if !loaded {
             violation(format!(
                 "fetchSuite({}, {version}) before the load action",
@@ -159,12 +157,7 @@ pub(super) fn accept(st: OfxStatus, what: &str, effect: &Effect) -> Result<(), H
 pub(super) fn failure(status: OfxStatus, what: &str, effect: Option<&Effect>) -> HostError {
     let mut messages = effect.map(|e| e.take_messages()).unwrap_or_default();
     // Render-time errors arrive as the persistent message (message suite v2).
-    if let Some(m) = effect.and_then(|e| {
-        e.persistent
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone()
-    }) {
+    if let Some(m) = effect.and_then(|e| e.persistent.locked().clone()) {
         messages.push(m);
     }
     let errors: Vec<&Message> = messages
@@ -383,14 +376,11 @@ impl Bundle {
     /// Sends the load action to `plugin` once (the spec: before describe,
     /// and never twice without an unload). Suites may be fetched from then on.
     pub(super) fn send_load(&self, plugin: *const OfxPlugin) -> Result<(), HostError> {
-        let mut loaded = self.loaded.lock().unwrap_or_else(|e| e.into_inner());
+        let mut loaded = self.loaded.locked();
         if loaded.contains(&(plugin as usize)) {
             return Ok(());
         }
-        LOADED_HOSTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(self.host.host as usize);
+        LOADED_HOSTS.locked().push(self.host.host as usize);
         let st = self.call(plugin, kOfxActionLoad, std::ptr::null(), None, None);
         if st != kOfxStatOK && st != kOfxStatReplyDefault {
             return Err(HostError::failed(format!(
@@ -404,7 +394,7 @@ impl Bundle {
 
 impl Drop for Bundle {
     fn drop(&mut self) {
-        let loaded = std::mem::take(&mut *self.loaded.lock().unwrap_or_else(|e| e.into_inner()));
+        let loaded = std::mem::take(&mut *self.loaded.locked());
         for plugin in loaded {
             let _ = self.call(
                 plugin as *const OfxPlugin,
@@ -415,8 +405,7 @@ impl Drop for Bundle {
             );
         }
         LOADED_HOSTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
+            .locked()
             .retain(|h| *h != self.host.host as usize);
     }
 }

@@ -15,6 +15,7 @@ use openfx::sys::image_effect_v1::param::*;
 use super::frame::Frame;
 use super::params::ParamSet;
 use super::props::PropertySet;
+use crate::sync::Locked;
 
 /// Supplies a clip's frames.
 pub trait FrameSource: Send + Sync {
@@ -115,8 +116,7 @@ impl Effect {
             persistent: Mutex::new(None),
         });
         LIVE_EFFECTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
+            .locked()
             .get_or_insert_with(HashSet::new)
             .insert(&*e as *const Effect as usize);
         e
@@ -127,7 +127,7 @@ impl Effect {
     }
 
     pub fn clip(&self, name: &str) -> Option<&Clip> {
-        let clips = self.clips.lock().unwrap_or_else(|e| e.into_inner());
+        let clips = self.clips.locked();
         // SAFETY: clips are boxed and never removed while the effect lives.
         clips
             .iter()
@@ -136,12 +136,7 @@ impl Effect {
     }
 
     pub fn clip_names(&self) -> Vec<String> {
-        self.clips
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .iter()
-            .map(|c| c.name.clone())
-            .collect()
+        self.clips.locked().iter().map(|c| c.name.clone()).collect()
     }
 
     pub fn add_clip(&self, name: &str, props: PropertySet) -> &Clip {
@@ -154,31 +149,27 @@ impl Effect {
             effect: self,
         });
         clip.props.set_str(kOfxPropName, name);
-        let mut clips = self.clips.lock().unwrap_or_else(|e| e.into_inner());
+        let mut clips = self.clips.locked();
         clips.push(clip);
         // SAFETY: just pushed a box that lives as long as the effect.
         unsafe { &*(&**clips.last().expect("pushed") as *const Clip) }
     }
 
     pub fn take_messages(&self) -> Vec<Message> {
-        std::mem::take(&mut *self.messages.lock().unwrap_or_else(|e| e.into_inner()))
+        std::mem::take(&mut *self.messages.locked())
     }
 }
 
 impl Drop for Effect {
     fn drop(&mut self) {
-        if let Some(set) = LIVE_EFFECTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .as_mut()
-        {
+        if let Some(set) = LIVE_EFFECTS.locked().as_mut() {
             set.remove(&(self as *const Effect as usize));
         }
     }
 }
 
 pub(super) fn live_effect<'a>(h: *const c_void) -> Option<&'a Effect> {
-    let live = LIVE_EFFECTS.lock().unwrap_or_else(|e| e.into_inner());
+    let live = LIVE_EFFECTS.locked();
     if live.as_ref().is_some_and(|s| s.contains(&(h as usize))) {
         // SAFETY: registered effects are live boxes (removed on drop).
         Some(unsafe { &*(h as *const Effect) })
@@ -313,41 +304,24 @@ impl Clip {
 
     /// The frame this clip shows at `time` and the render scale in force.
     pub fn frame_at(&self, time: f64) -> Result<Option<Arc<Frame>>, String> {
-        if let Some(out) = self
-            .output
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone()
-        {
+        if let Some(out) = self.output.locked().clone() {
             return Ok(Some(out));
         }
-        let source = self
-            .source
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone();
+        let source = self.source.locked().clone();
         let Some(source) = source else {
             return Ok(None);
         };
         let mut frame = source.frame(time)?;
         // The spec's default extraction: one field, each line doubled.
-        let field = *self
-            .effect()
-            .field
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let field = *self.effect().field.locked();
         if matches!(field, "OfxImageFieldLower" | "OfxImageFieldUpper") {
             frame = Arc::new(frame.field_doubled(field == "OfxImageFieldUpper"));
         }
-        let scale = *self
-            .effect()
-            .render_scale
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let scale = *self.effect().render_scale.locked();
         if scale == (1.0, 1.0) {
             return Ok(Some(frame));
         }
-        let mut proxy = self.proxy.lock().unwrap_or_else(|e| e.into_inner());
+        let mut proxy = self.proxy.locked();
         if let Some((from, at, made)) = proxy.as_ref() {
             if Arc::ptr_eq(from, &frame) && *at == scale {
                 return Ok(Some(made.clone()));
@@ -360,11 +334,7 @@ impl Clip {
 
     /// Canonical region of definition at `time` (the full-resolution bounds).
     pub fn rod(&self, time: f64) -> Option<RectI> {
-        let source = self
-            .source
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone()?;
+        let source = self.source.locked().clone()?;
         if source.infinite() {
             return Some(INFINITE);
         }
@@ -398,23 +368,15 @@ unsafe extern "C" fn clip_get_image(
             Ok(Some(f)) => f,
             Ok(None) => return kOfxStatFailed,
             Err(message) => {
-                c.effect()
-                    .messages
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .push(Message {
-                        kind: "OfxMessageError".into(),
-                        id: "net.morphfx.harness.MissingFrame".into(),
-                        text: message,
-                    });
+                c.effect().messages.locked().push(Message {
+                    kind: "OfxMessageError".into(),
+                    id: "net.morphfx.harness.MissingFrame".into(),
+                    text: message,
+                });
                 return kOfxStatFailed;
             }
         };
-        let scale = *c
-            .effect()
-            .render_scale
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let scale = *c.effect().render_scale.locked();
         let props = frame.image_props(scale, time);
         super::misuse::tamper_image(&c.name, &props);
         // SAFETY: out-pointer from the plugin. The boxed set (owning the frame) is
@@ -443,7 +405,7 @@ unsafe extern "C" fn clip_release_image(image: OfxPropertySetHandle) -> OfxStatu
         let mut set = unsafe { Box::from_raw(image as *mut PropertySet) };
         set.owner = None;
         set.clear();
-        let mut released = RELEASED.lock().unwrap_or_else(|e| e.into_inner());
+        let mut released = RELEASED.locked();
         if released.len() == RELEASED_KEPT {
             // A long render stays flat in memory: the oldest shells go (a
             // plugin misusing an image does so within a frame or two).
@@ -560,7 +522,7 @@ const UNOWNED_KEPT: usize = 256;
 
 /// Takes the messages the plugin posted with no effect handle.
 pub fn take_unowned_messages() -> Vec<Message> {
-    std::mem::take(&mut *UNOWNED.lock().unwrap_or_else(|e| e.into_inner()))
+    std::mem::take(&mut *UNOWNED.locked())
 }
 
 /// # Safety
@@ -576,10 +538,10 @@ pub unsafe extern "C" fn mfx_message_text(
         // SAFETY: the shim passes C strings or nulls.
         let m = unsafe { message_of(kind, id, text) };
         match live_effect(handle) {
-            Some(e) => e.messages.lock().unwrap_or_else(|e| e.into_inner()).push(m),
+            Some(e) => e.messages.locked().push(m),
             None => {
                 eprintln!("morphfx: plugin says ({}): {}", m.kind, m.text);
-                let mut unowned = UNOWNED.lock().unwrap_or_else(|e| e.into_inner());
+                let mut unowned = UNOWNED.locked();
                 if unowned.len() < UNOWNED_KEPT {
                     unowned.push(m);
                 }
@@ -605,7 +567,7 @@ pub unsafe extern "C" fn mfx_persistent_text(
         };
         // SAFETY: the shim passes C strings or nulls.
         let m = unsafe { message_of(kind, id, text) };
-        *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = Some(m);
+        *e.persistent.locked() = Some(m);
         kOfxStatOK
     })
 }
@@ -615,7 +577,7 @@ unsafe extern "C" fn clear_persistent(handle: *mut c_void) -> OfxStatus {
         let Some(e) = live_effect(handle) else {
             return kOfxStatErrBadHandle;
         };
-        *e.persistent.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        *e.persistent.locked() = None;
         kOfxStatOK
     })
 }
@@ -654,9 +616,7 @@ mod tests {
 
     #[test]
     fn an_image_used_after_release_is_a_violation_not_a_crash() {
-        let _one_at_a_time = super::super::VIOLATION_TESTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let _one_at_a_time = super::super::VIOLATION_TESTS.locked();
         let set = PropertySet::new();
         set.set_int(kOfxImagePropRowBytes, &[256]);
         let h = Box::into_raw(Box::new(set)) as OfxPropertySetHandle;

@@ -7,12 +7,14 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
+use crate::sync::Locked;
+
 /// The callback a test arms to panic on its next call ([`panic_in`]).
 static ARMED: Mutex<Option<&'static str>> = Mutex::new(None);
 
 /// Makes the next call of host callback `name` panic (tests of [`guard`]).
 pub fn panic_in(name: Option<&'static str>) {
-    *ARMED.lock().unwrap_or_else(|e| e.into_inner()) = name;
+    *ARMED.locked() = name;
 }
 
 /// Runs callback `name`'s `body`; on a panic, records it as a host failure
@@ -20,7 +22,7 @@ pub fn panic_in(name: Option<&'static str>) {
 pub fn guard<R>(on_panic: R, name: &'static str, body: impl FnOnce() -> R) -> R {
     let run = AssertUnwindSafe(|| {
         let armed = {
-            let mut a = ARMED.lock().unwrap_or_else(|e| e.into_inner());
+            let mut a = ARMED.locked();
             a.take_if(|n| *n == name).is_some()
         };
         if armed {

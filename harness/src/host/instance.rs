@@ -15,6 +15,7 @@ use super::error::HostError;
 use super::frame::{self, Frame};
 use super::params::{self, ParamValue};
 use super::props::PropertySet;
+use crate::sync::Locked;
 
 /// A new instance of `descriptor` in `context`: its params and clips copied
 /// from the descriptor, the clips unconnected until a job connects them.
@@ -36,12 +37,7 @@ fn instance_effect(descriptor: &Effect, context: &str) -> Box<Effect> {
         .props
         .set_ptr(kOfxPropInstanceData, std::ptr::null_mut());
     let desc_params = params::ParamSet::instance_of(&descriptor.params);
-    *effect
-        .params
-        .params
-        .lock()
-        .unwrap_or_else(|e| e.into_inner()) =
-        std::mem::take(&mut *desc_params.params.lock().unwrap_or_else(|e| e.into_inner()));
+    *effect.params.params.locked() = std::mem::take(&mut *desc_params.params.locked());
     for name in descriptor.clip_names() {
         let desc_clip = descriptor.clip(&name).expect("listed");
         let clip = effect.add_clip(&name, desc_clip.props.clone_values());
@@ -196,38 +192,20 @@ impl Instance<'_> {
     /// The user will press cancel on the plugin's progress bar once it
     /// reaches `at` (`None`: never).
     pub fn cancel_progress_at(&self, at: Option<f64>) {
-        *self
-            .effect
-            .cancel_at
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()) = at;
+        *self.effect.cancel_at.locked() = at;
     }
 
     /// Every progress the plugin reported so far, and whether a progress
     /// task is still open.
     pub fn progress_log(&self) -> (Vec<f64>, bool) {
-        let log = self
-            .effect
-            .progress_log
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone();
-        let open = self
-            .effect
-            .progress
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .is_some();
+        let log = self.effect.progress_log.locked().clone();
+        let open = self.effect.progress.locked().is_some();
         (log, open)
     }
 
     /// Tells the plugin the user changed (or pressed) param `name` at `time`.
     pub fn instance_changed(&self, name: &str, time: f64) -> Result<(), HostError> {
-        *self
-            .effect
-            .render_scale
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()) = (1.0, 1.0);
+        *self.effect.render_scale.locked() = (1.0, 1.0);
         let name = CString::new(name).map_err(|_| HostError::bad("NUL in a param name"))?;
         let a = PropertySet::new();
         a.set_str(kOfxPropType, "OfxTypeParameter");
@@ -264,8 +242,7 @@ impl Instance<'_> {
     pub fn persistent_message(&self) -> Option<String> {
         self.effect
             .persistent
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
+            .locked()
             .as_ref()
             .map(|m| m.text.clone())
     }
@@ -328,7 +305,7 @@ impl Instance<'_> {
             c.props
                 .set_double(kOfxImageEffectPropFrameRange, &[first, last]);
         }
-        *c.source.lock().unwrap_or_else(|e| e.into_inner()) = Some(source);
+        *c.source.locked() = Some(source);
         c.props.set_int(kOfxImageClipPropConnected, &[1]);
         Ok(())
     }
@@ -339,7 +316,7 @@ impl Instance<'_> {
         self.effect
             .props
             .set_double(kOfxImageEffectPropProjectPixelAspectRatio, &[par]);
-        let clips = self.effect.clips.lock().unwrap_or_else(|e| e.into_inner());
+        let clips = self.effect.clips.locked();
         for clip in clips.iter() {
             clip.props.set_double(kOfxImagePropPixelAspectRatio, &[par]);
         }
@@ -449,13 +426,7 @@ impl Instance<'_> {
     /// taken, its persistent one taken too.
     fn messages_posted(&self) -> Vec<Message> {
         let mut messages = self.effect.take_messages();
-        messages.extend(
-            self.effect
-                .persistent
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .take(),
-        );
+        messages.extend(self.effect.persistent.locked().take());
         messages
     }
 
@@ -492,11 +463,7 @@ impl Instance<'_> {
     }
 
     pub fn begin_sequence(&self, first: f64, last: f64) -> Result<(), HostError> {
-        *self
-            .effect
-            .timeline
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()) = (first, first, last);
+        *self.effect.timeline.locked() = (first, first, last);
         let a = Self::sequence_args(first, last);
         self.act(kOfxImageEffectActionBeginSequenceRender, Some(&a), None)
             .map(|_| ())
@@ -564,7 +531,7 @@ impl Instance<'_> {
     /// input clips' regions; this host gives an unconnected clip none, and
     /// with none at all the default is the project's.
     fn default_region(&self, time: f64) -> RectI {
-        let clips = self.effect.clips.lock().unwrap_or_else(|e| e.into_inner());
+        let clips = self.effect.clips.locked();
         clips
             .iter()
             .filter(|c| c.name != "Output")
@@ -623,12 +590,8 @@ impl Instance<'_> {
     /// Interlaced footage, `order` (`OfxImageFieldLower` or `Upper`) first:
     /// renders then go field by field as the plugin asks.
     pub fn set_field_order(&self, order: &'static str) {
-        *self
-            .effect
-            .field_order
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()) = Some(order);
-        let clips = self.effect.clips.lock().unwrap_or_else(|e| e.into_inner());
+        *self.effect.field_order.locked() = Some(order);
+        let clips = self.effect.clips.locked();
         for clip in clips.iter() {
             clip.props.set_str(kOfxImageClipPropFieldOrder, order);
         }
@@ -640,11 +603,7 @@ impl Instance<'_> {
     /// with lines doubled, the output interleaving the two; otherwise once,
     /// both fields at a time (this host animates nothing it renders).
     pub fn render(&self, time: f64, spec: OutputSpec) -> Result<Arc<Frame>, HostError> {
-        let order = *self
-            .effect
-            .field_order
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let order = *self.effect.field_order.locked();
         let Some(first) = order else {
             return self.render_field(time, spec, "OfxImageFieldNone");
         };
@@ -663,7 +622,7 @@ impl Instance<'_> {
         };
         let a = self.render_field(time, spec, first)?.to_image();
         let b = self.render_field(time + 0.5, spec, second)?.to_image();
-        *self.effect.field.lock().unwrap_or_else(|e| e.into_inner()) = "OfxImageFieldNone";
+        *self.effect.field.locked() = "OfxImageFieldNone";
         let upper_first = first == "OfxImageFieldUpper";
         let both = morphfx::image::Image::from_fn(a.bounds, a.channels, |i, j, c| {
             let upper = j.rem_euclid(2) == 1;
@@ -698,12 +657,12 @@ impl Instance<'_> {
             .effect
             .clip("Output")
             .ok_or_else(|| HostError::failed("the plugin has no Output clip"))?;
-        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = Some(out.clone());
+        *out_clip.output.locked() = Some(out.clone());
         out_clip
             .props
             .set_str(kOfxImageEffectPropPixelDepth, spec.depth);
         let result = self.render_tiles(time, spec, field, bounds);
-        *out_clip.output.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        *out_clip.output.locked() = None;
         result?;
         Ok(out)
     }
@@ -711,18 +670,10 @@ impl Instance<'_> {
     /// What the plugin may ask the host during a render: the field, the
     /// time on the timeline and the render scale.
     fn set_render_state(&self, time: f64, scale: (f64, f64), field: &'static str) {
-        *self.effect.field.lock().unwrap_or_else(|e| e.into_inner()) = field;
+        *self.effect.field.locked() = field;
         self.effect.take_messages();
-        self.effect
-            .timeline
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .0 = time;
-        *self
-            .effect
-            .render_scale
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()) = scale;
+        self.effect.timeline.locked().0 = time;
+        *self.effect.render_scale.locked() = scale;
     }
 
     /// The pixels to render: the region of definition at `scale` (the

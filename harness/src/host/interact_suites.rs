@@ -15,6 +15,7 @@ use openfx::sys::image_effect_v1::pixels::OfxRGBAColourF;
 
 use super::checks::violation;
 use super::props::PropertySet;
+use crate::sync::Locked;
 
 /// Our host's own property: 1 when it offers the Draw suite.
 pub const DRAW_SUITE_PROP: &CStr = c"net.morphfx.harness.DrawSuite";
@@ -77,7 +78,7 @@ fn record(h: OfxDrawContextHandle, what: &str, call: DrawCall) -> OfxStatus {
     // SAFETY: the plugin passes the handle we gave it (checked there).
     match unsafe { context(h, what) } {
         Some(c) => {
-            c.calls.lock().unwrap_or_else(|e| e.into_inner()).push(call);
+            c.calls.locked().push(call);
             kOfxStatOK
         }
         None => kOfxStatFailed,

@@ -10,6 +10,7 @@ use std::ffi::CStr;
 use std::sync::{Mutex, MutexGuard};
 
 use super::props::PropertySet;
+use crate::sync::Locked;
 
 /// One kind of misbehaviour.
 #[derive(Clone, Copy)]
@@ -49,13 +50,13 @@ impl Drop for Armed {
 /// Arms `misuses` (none: a well-behaved host, still serialised with the
 /// tests that arm some) until the returned value is dropped.
 pub fn arm(misuses: &[Misuse]) -> Armed {
-    let serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let serial = SERIAL.locked();
     *armed() = misuses.to_vec();
     Armed { _serial: serial }
 }
 
 fn armed() -> MutexGuard<'static, Vec<Misuse>> {
-    ARMED.lock().unwrap_or_else(|e| e.into_inner())
+    ARMED.locked()
 }
 
 pub(crate) fn withholds(suite: &CStr) -> bool {

@@ -16,6 +16,7 @@ pub use super::interact_suites::{DrawCall, DRAW_SUITE_PROP};
 use super::params::Inside;
 use super::props::{PropertySet, Value};
 use super::{HostError, Instance};
+use crate::sync::Locked;
 
 type Entry = unsafe extern "C" fn(
     *const c_char,
@@ -163,11 +164,8 @@ impl<'i> Overlay<'i> {
         }
         let result = self.call(kOfxInteractActionDraw, Some(&a));
         context.open.store(false, Ordering::Release);
-        let calls = std::mem::take(&mut *context.calls.lock().unwrap_or_else(|e| e.into_inner()));
-        self.contexts
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(context);
+        let calls = std::mem::take(&mut *context.calls.locked());
+        self.contexts.locked().push(context);
         result.map(|_| calls)
     }
 

@@ -8,6 +8,7 @@ use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::param::*;
 
 use super::props::PropertySet;
+use crate::sync::Locked;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shape {
@@ -100,7 +101,7 @@ impl Param {
     }
 
     fn state(&self) -> std::sync::MutexGuard<'_, (ParamValue, Vec<(f64, ParamValue)>)> {
-        self.state.lock().unwrap_or_else(|e| e.into_inner())
+        self.state.locked()
     }
 
     pub fn value_at(&self, time: f64) -> ParamValue {
@@ -162,7 +163,7 @@ pub struct ParamSet {
 
 impl ParamSet {
     pub fn find(&self, name: &str) -> Option<*const Param> {
-        let params = self.params.lock().unwrap_or_else(|e| e.into_inner());
+        let params = self.params.locked();
         params
             .iter()
             .find(|p| p.name == name)
@@ -170,7 +171,7 @@ impl ParamSet {
     }
     /// The instance's copy of a descriptor's params.
     pub fn instance_of(desc: &ParamSet) -> ParamSet {
-        let params = desc.params.lock().unwrap_or_else(|e| e.into_inner());
+        let params = desc.params.locked();
         ParamSet {
             props: desc.props.clone_values(),
             params: Mutex::new(
@@ -182,7 +183,7 @@ impl ParamSet {
         }
     }
     pub fn names(&self) -> Vec<(String, String)> {
-        let params = self.params.lock().unwrap_or_else(|e| e.into_inner());
+        let params = self.params.locked();
         params
             .iter()
             .map(|p| (p.name.clone(), p.kind.clone()))
@@ -219,7 +220,7 @@ unsafe extern "C" fn param_define(
         // SAFETY: both checked non-null just above; OFX strings are NUL-terminated.
         let (kind, name) = unsafe { (CStr::from_ptr(kind), CStr::from_ptr(name)) };
         let name = name.to_string_lossy().into_owned();
-        let mut params = set.params.lock().unwrap_or_else(|e| e.into_inner());
+        let mut params = set.params.locked();
         if params.iter().any(|p| p.name == name) {
             return kOfxStatErrExists;
         }
@@ -639,9 +640,7 @@ mod tests {
 
     #[test]
     fn param_writes_outside_instance_changed_are_violations() {
-        let _one_at_a_time = super::super::VIOLATION_TESTS
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let _one_at_a_time = super::super::VIOLATION_TESTS.locked();
         let param = Param {
             name: "written_param".into(),
             kind: "OfxParamTypeDouble".into(),

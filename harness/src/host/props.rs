@@ -9,6 +9,8 @@ use std::sync::Mutex;
 use openfx::sys::generic::core::*;
 use openfx::sys::generic::property::*;
 
+use crate::sync::Locked;
+
 #[derive(Debug, Clone)]
 pub enum Value {
     S(Vec<CString>),
@@ -32,7 +34,7 @@ impl PropertySet {
         Self::default()
     }
     fn map(&self) -> std::sync::MutexGuard<'_, HashMap<String, Value>> {
-        self.values.lock().unwrap_or_else(|e| e.into_inner())
+        self.values.locked()
     }
     pub fn set(&self, name: &CStr, v: Value) {
         self.map().insert(name.to_string_lossy().into_owned(), v);

@@ -13,6 +13,7 @@ use openfx::sys::image_effect_v1::progress::*;
 use openfx::sys::image_effect_v1::time_line::*;
 
 use super::effect::live_effect;
+use crate::sync::Locked;
 
 // ---- memory -------------------------------------------------------------
 
@@ -151,7 +152,7 @@ struct RecursiveMutex {
 impl RecursiveMutex {
     fn try_lock(&self, wait: bool) -> bool {
         let me = std::thread::current().id();
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let mut s = self.state.locked();
         loop {
             match s.0 {
                 None => {
@@ -170,7 +171,7 @@ impl RecursiveMutex {
 
     fn unlock(&self) -> bool {
         let me = std::thread::current().id();
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let mut s = self.state.locked();
         if s.0 != Some(me) {
             return false;
         }
@@ -282,7 +283,7 @@ unsafe extern "C" fn progress_start_v2(
         };
         // SAFETY: see `text`.
         let label = unsafe { text(message) };
-        *e.progress.lock().unwrap_or_else(|p| p.into_inner()) = Some((label, 0.0));
+        *e.progress.locked() = Some((label, 0.0));
         kOfxStatOK
     })
 }
@@ -299,19 +300,11 @@ unsafe extern "C" fn progress_update(instance: *mut c_void, progress: f64) -> Of
         let Some(e) = live_effect(instance) else {
             return kOfxStatErrBadHandle;
         };
-        match e
-            .progress
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .as_mut()
-        {
+        match e.progress.locked().as_mut() {
             Some(task) => {
                 task.1 = progress.clamp(0.0, 1.0);
-                e.progress_log
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .push(task.1);
-                match *e.cancel_at.lock().unwrap_or_else(|p| p.into_inner()) {
+                e.progress_log.locked().push(task.1);
+                match *e.cancel_at.locked() {
                     Some(at) if task.1 >= at => kOfxStatReplyNo,
                     _ => kOfxStatOK,
                 }
@@ -326,7 +319,7 @@ unsafe extern "C" fn progress_end(instance: *mut c_void) -> OfxStatus {
         let Some(e) = live_effect(instance) else {
             return kOfxStatErrBadHandle;
         };
-        *e.progress.lock().unwrap_or_else(|p| p.into_inner()) = None;
+        *e.progress.locked() = None;
         kOfxStatOK
     })
 }
@@ -349,7 +342,7 @@ unsafe extern "C" fn get_time(instance: *mut c_void, time: *mut f64) -> OfxStatu
     super::guard::guard(kOfxStatErrUnknown, "get_time", || {
         match live_effect(instance) {
             Some(e) if !time.is_null() => {
-                let t = e.timeline.lock().unwrap_or_else(|p| p.into_inner()).0;
+                let t = e.timeline.locked().0;
                 // SAFETY: checked non-null.
                 unsafe { *time = t };
                 kOfxStatOK
@@ -363,7 +356,7 @@ unsafe extern "C" fn goto_time(instance: *mut c_void, time: f64) -> OfxStatus {
     super::guard::guard(kOfxStatErrUnknown, "goto_time", || {
         match live_effect(instance) {
             Some(e) if time.is_finite() => {
-                e.timeline.lock().unwrap_or_else(|p| p.into_inner()).0 = time;
+                e.timeline.locked().0 = time;
                 kOfxStatOK
             }
             Some(_) => kOfxStatErrValue,
@@ -380,7 +373,7 @@ unsafe extern "C" fn get_time_bounds(
     super::guard::guard(kOfxStatErrUnknown, "get_time_bounds", || {
         match live_effect(instance) {
             Some(e) if !first.is_null() && !last.is_null() => {
-                let (_, a, b) = *e.timeline.lock().unwrap_or_else(|p| p.into_inner());
+                let (_, a, b) = *e.timeline.locked();
                 // SAFETY: both checked non-null.
                 unsafe {
                     *first = a;

@@ -13,6 +13,7 @@ use morphfx::warp::thin_plate::ThinPlate;
 
 use super::NodeKind;
 use crate::cache::{Cache, Key, WarpCache};
+use crate::sync::Locked;
 use crate::wrapper::params::Params;
 use crate::wrapper::plugin::Context;
 
@@ -97,33 +98,27 @@ impl NodeState {
     pub fn purge(&self) {
         self.warps.clear();
         self.field_maps.clear();
-        *self.scene.lock().unwrap_or_else(|e| e.into_inner()) = None;
-        self.planes
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clear();
+        *self.scene.locked() = None;
+        self.planes.locked().clear();
         self.correspondences.clear();
         self.weights.clear();
     }
 
     /// `side`'s last field map, if the cache still holds it.
     pub fn last_field(&self, side: Side) -> Option<Arc<FieldMap>> {
-        let last = self.last_field.lock().unwrap_or_else(|e| e.into_inner());
+        let last = self.last_field.locked();
         last[side_index(side)].upgrade()
     }
 
     /// Makes `map` the one the next viewer render of `side` redoes.
     pub fn set_last_field(&self, side: Side, map: &Arc<FieldMap>) {
-        let mut last = self.last_field.lock().unwrap_or_else(|e| e.into_inner());
+        let mut last = self.last_field.locked();
         last[side_index(side)] = Arc::downgrade(map);
     }
 
     /// True the first time `what` is asked about.
     pub fn first_time(&self, what: &str) -> bool {
-        self.said
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .insert(what.to_owned())
+        self.said.locked().insert(what.to_owned())
     }
 }
 

@@ -14,6 +14,7 @@ use openfx::sys::image_effect_v1::param::*;
 use openfx::sys::image_effect_v1::progress::*;
 
 use super::{Failure, Outcome};
+use crate::sync::RwLocked;
 
 #[derive(Clone, Copy)]
 pub struct Suites {
@@ -93,7 +94,7 @@ pub fn load() -> Outcome {
     let missing = |f: Failure| {
         // A host that failed our load gets no use of suites fetched from a
         // host before it.
-        *SUITES.write().unwrap_or_else(|e| e.into_inner()) = None;
+        *SUITES.write_locked() = None;
         f
     };
     let prop = required(kOfxPropertySuite, 1).map_err(missing)? as *const OfxPropertySuiteV1;
@@ -120,7 +121,7 @@ pub fn load() -> Outcome {
     };
     switches();
     // A later load (a host that reloads us) replaces the suites.
-    *SUITES.write().unwrap_or_else(|e| e.into_inner()) = Some(suites);
+    *SUITES.write_locked() = Some(suites);
     Ok(())
 }
 
@@ -179,8 +180,7 @@ pub fn switches() -> &'static Switches {
 
 pub fn suites() -> Outcome<Suites> {
     SUITES
-        .read()
-        .unwrap_or_else(|e| e.into_inner())
+        .read_locked()
         .ok_or_else(|| Failure::Failed("the host never sent the load action".into()))
 }
 

@@ -11,8 +11,6 @@ pub mod paint;
 mod pen;
 pub mod shapes;
 
-use std::sync::Mutex;
-
 use morphfx::features::Side;
 use morphfx::geom::Vec2;
 use morphfx::scene::edit::Document;
@@ -30,6 +28,7 @@ use super::params::{
 };
 use super::render::{load_scene, warp_inputs};
 use super::{Node, NodeState};
+use crate::sync::Locked;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::plugin::{DrawArgs, Overlay, Pen};
 use crate::wrapper::{Outcome, Reply};
@@ -155,10 +154,6 @@ fn slave_params() -> Vec<String> {
     ids
 }
 
-fn lock(state: &Mutex<State>) -> std::sync::MutexGuard<'_, State> {
-    state.lock().unwrap_or_else(|e| e.into_inner())
-}
-
 /// Every feature of the node at `time`, with the progress and the frames
 /// Scene Text's shapes are keyed at. A scene that does not parse is drawn
 /// as nothing (the slots still are).
@@ -214,7 +209,7 @@ fn view(instance: &NodeState, time: f64) -> View {
 fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Outcome<Reply> {
     let (kind, time, pixel) = (instance.kind, args.time, args.pixel);
     if args.measured {
-        lock(&instance.overlay).measured_pixel = Some(pixel);
+        instance.overlay.locked().measured_pixel = Some(pixel);
     }
     let show: Show = Reader::new(instance.params(), kind, time).choice(&OVERLAY_SHOW);
     if show == Show::Off {
@@ -228,7 +223,7 @@ fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) -> Out
         .map(|o| outline::in_between(o, v.t, field))
         .collect();
     let (hover, building) = {
-        let state = lock(&instance.overlay);
+        let state = instance.overlay.locked();
         let building = state
             .building
             .as_ref()
@@ -277,7 +272,7 @@ fn pixel_of(state: &State, pen: &Pen) -> (f64, f64) {
 
 /// Key up: releases a modifier.
 fn key_up(instance: &NodeState, sym: i32) -> Outcome<Reply> {
-    let mut state = lock(&instance.overlay);
+    let mut state = instance.overlay.locked();
     if keys::SHIFT.contains(&sym) {
         state.shift = false;
     }
@@ -290,7 +285,7 @@ fn key_up(instance: &NodeState, sym: i32) -> Outcome<Reply> {
 /// Focus lost: no key is held any more as far as we can know, and nothing
 /// is under the pen.
 fn lose_focus(instance: &NodeState) -> Outcome<Reply> {
-    let mut state = lock(&instance.overlay);
+    let mut state = instance.overlay.locked();
     state.shift = false;
     state.ctrl = false;
     state.hover = None;
@@ -299,7 +294,7 @@ fn lose_focus(instance: &NodeState) -> Outcome<Reply> {
 
 /// The Finish Shape button: the polyline or curve being drawn ends open.
 pub fn finish_shape(instance: &NodeState) {
-    let mut state = lock(&instance.overlay);
+    let mut state = instance.overlay.locked();
     if let Some(b) = state.building.take() {
         state.selected = b.feature.or(state.selected);
     }
@@ -308,7 +303,7 @@ pub fn finish_shape(instance: &NodeState) {
 /// The Delete Shape button: the shape last drawn or grabbed leaves Scene Text.
 pub fn delete_shape(instance: &NodeState, effect: &EffectHandle, time: f64) -> Outcome {
     let selected = {
-        let mut state = lock(&instance.overlay);
+        let mut state = instance.overlay.locked();
         state.building = None;
         state.hover = None;
         state.selected.take()

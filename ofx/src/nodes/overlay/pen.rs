@@ -10,11 +10,12 @@ use morphfx::geom::Vec2;
 use super::hit::{self, Handle, Part};
 use super::outline::Owner;
 use super::shapes::{self, refused};
-use super::{editable, lock, pixel_of, view, Building, Drag, MIN_NEW_LINE_PX};
+use super::{editable, pixel_of, view, Building, Drag, MIN_NEW_LINE_PX};
 use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
 use crate::nodes::params::{OVERLAY_EDIT, OVERLAY_SHOW};
 use crate::nodes::NodeState;
+use crate::sync::Locked;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::params::Params;
 use crate::wrapper::plugin::Pen;
@@ -23,13 +24,13 @@ use crate::wrapper::{keys, Failure, Outcome, Reply};
 /// Pen down: a click of a shape being drawn, else a grab of what is under
 /// the pen, else the draw tool's new feature.
 pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
-    if lock(&instance.overlay).building.is_some() {
+    if instance.overlay.locked().building.is_some() {
         return building_click(instance, effect, pen);
     }
     let r = Reader::new(instance.params(), instance.kind, pen.time);
     let tool: DrawTool = r.choice(&DRAW_TOOL);
     let (handle, sides) = {
-        let state = lock(&instance.overlay);
+        let state = instance.overlay.locked();
         let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
         let outlines = view(instance, pen.time).outlines;
         let handle = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
@@ -69,11 +70,11 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
         },
     };
     if let Drag::Shape { feature, .. } = &drag {
-        lock(&instance.overlay).selected = Some(*feature);
+        instance.overlay.locked().selected = Some(*feature);
     }
-    lock(&instance.overlay).drag = Some(drag.clone());
+    instance.overlay.locked().drag = Some(drag.clone());
     if let Err(why) = write_drag(instance, &drag, pen) {
-        lock(&instance.overlay).drag = None;
+        instance.overlay.locked().drag = None;
         let _ = instance.params().end_edit();
         return refuse(instance, effect, why);
     }
@@ -243,7 +244,7 @@ pub fn motion(
     pen: Pen,
     redraw: &mut dyn FnMut(),
 ) -> Outcome<Reply> {
-    let drag = lock(&instance.overlay).drag.clone();
+    let drag = instance.overlay.locked().drag.clone();
     if let Some(drag) = drag {
         // A drag that would break the scene keeps its last good position.
         return match write_drag(instance, &drag, pen) {
@@ -252,7 +253,7 @@ pub fn motion(
         };
     }
     let r = Reader::new(instance.params(), instance.kind, pen.time);
-    let mut state = lock(&instance.overlay);
+    let mut state = instance.overlay.locked();
     let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
     let outlines = view(instance, pen.time).outlines;
     let hover = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
@@ -277,7 +278,7 @@ pub fn motion(
 pub fn up(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
     let params = instance.params();
     let (drag, pixel) = {
-        let mut state = lock(&instance.overlay);
+        let mut state = instance.overlay.locked();
         (state.drag.take(), pixel_of(&state, &pen))
     };
     let Some(drag) = drag else {
@@ -331,7 +332,7 @@ fn start_building(
         DrawTool::Curve => FeatureKind::Curve,
         _ => FeatureKind::Polyline,
     };
-    let mut state = lock(&instance.overlay);
+    let mut state = instance.overlay.locked();
     state.building = Some(Building {
         kind,
         points: vec![pen.at],
@@ -346,7 +347,7 @@ fn start_building(
 /// ends it open; elsewhere adds a control point. One undo step per click.
 fn building_click(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
     let (b, pixel) = {
-        let state = lock(&instance.overlay);
+        let state = instance.overlay.locked();
         let Some(b) = state.building.clone() else {
             return Ok(Reply::Default);
         };
@@ -380,7 +381,7 @@ fn building_click(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outc
     });
     match result {
         Ok(feature) => {
-            let mut state = lock(&instance.overlay);
+            let mut state = instance.overlay.locked();
             if let Some(building) = state.building.as_mut() {
                 building.points.push(pen.at);
                 building.feature = Some(feature);
@@ -403,7 +404,7 @@ fn end_building(
     close: bool,
 ) -> Outcome<Reply> {
     {
-        let mut state = lock(&instance.overlay);
+        let mut state = instance.overlay.locked();
         state.building = None;
         state.selected = b.feature.or(state.selected);
     }
@@ -431,7 +432,7 @@ pub fn key_down(
     time: f64,
 ) -> Outcome<Reply> {
     let hovered = {
-        let mut state = lock(&instance.overlay);
+        let mut state = instance.overlay.locked();
         if keys::SHIFT.contains(&sym) {
             state.shift = true;
         }
@@ -466,7 +467,7 @@ pub fn key_down(
                 .map_err(refused)?;
                 delete_block(instance.params(), || shapes::write(instance, &doc))
             });
-            lock(&instance.overlay).selected = None;
+            instance.overlay.locked().selected = None;
             shapes::settle(instance, effect, result)?;
         }
         (Owner::File(_), _) => return Ok(Reply::Default),

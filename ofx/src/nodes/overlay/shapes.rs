@@ -6,6 +6,7 @@ use morphfx::scene::edit::Document;
 
 use crate::nodes::params::{Reader, SCENE_FILE, SCENE_TEXT};
 use crate::nodes::NodeState;
+use crate::sync::Locked;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::{Failure, Outcome};
 
@@ -90,7 +91,7 @@ pub fn copy_scene(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
 /// An edit's outcome on the node: a refusal shown, a success clearing the
 /// refusal an earlier edit showed.
 pub fn settle(instance: &NodeState, effect: &EffectHandle, result: Outcome) -> Outcome {
-    let shown = &mut super::lock(&instance.overlay).refused;
+    let shown = &mut instance.overlay.locked().refused;
     match result {
         Ok(()) => {
             if std::mem::take(shown) {

@@ -11,6 +11,7 @@ use morphfx::views::{self, View};
 use morphfx::warp::mesh::{self, MeshPair};
 
 use crate::nodes::state::PLANES_KEPT;
+use crate::sync::Locked;
 
 pub(super) struct Job<'a> {
     pub(super) view: View,
@@ -131,7 +132,7 @@ impl Job<'_> {
         let window = rows.bounds;
         let to = pair.at(self.t);
         let identity = WarpMap::identity(window, self.scale);
-        let pool = || self.planes.lock().unwrap_or_else(|e| e.into_inner());
+        let pool = || self.planes.locked();
         let plane = |side: Side, s: &Sampler<'_, S>| {
             let from = pair.side(side);
             (*from != to).then(|| {

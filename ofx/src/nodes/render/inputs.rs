@@ -10,6 +10,7 @@ use morphfx::scene::Scene;
 use crate::nodes::params::{Settings, TRANSITION_PARAM};
 use crate::nodes::state::NodeState;
 use crate::nodes::NodeKind;
+use crate::sync::Locked;
 use crate::wrapper::plugin::Context;
 use crate::wrapper::{Failure, Outcome};
 
@@ -31,7 +32,7 @@ pub(in crate::nodes) fn load_scene(
     } else {
         return Ok(None);
     };
-    let mut cached = instance.scene.lock().unwrap_or_else(|e| e.into_inner());
+    let mut cached = instance.scene.locked();
     if let Some((k, scene)) = cached.as_ref() {
         if *k == key {
             return Ok(Some(scene.clone()));

@@ -16,6 +16,7 @@ use morphfx::warp::thin_plate::ThinPlateWarp;
 use super::inputs::WarpInputs;
 use crate::cache::Key;
 use crate::nodes::state::{NodeState, GRIDS_KEPT, PLATES_KEPT};
+use crate::sync::Locked;
 use crate::wrapper::{Failure, Outcome};
 
 /// The frame's `auto` correspondence: solved once per content of the two
@@ -47,7 +48,7 @@ pub(super) fn correspondence(
         // started, so a farm's chunks differ from one call at their starts.
         let warm = sequential
             .then(|| {
-                let grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+                let grids = instance.grids.locked();
                 grids
                     .iter()
                     .find(|(t, k, _)| *t == time - 1.0 && *k == same_setup)
@@ -82,7 +83,7 @@ pub(super) fn correspondence(
                 auto::table_text(&table)
             );
         }
-        let mut grids = instance.grids.lock().unwrap_or_else(|e| e.into_inner());
+        let mut grids = instance.grids.locked();
         grids.retain(|(t, k, _)| !(*t == time && *k == same_setup));
         if grids.len() >= GRIDS_KEPT {
             grids.remove(0);
@@ -107,7 +108,7 @@ pub(super) fn thin_plate(
     let setup = Key::of(&(side, &inputs.warp.settings.thin_plate, inputs.warp.region));
     let warm = interactive
         .then(|| {
-            let plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+            let plates = instance.plates.locked();
             plates
                 .iter()
                 .filter(|(t, k, _)| *k == setup && (t - time).abs() <= 1.0)
@@ -132,7 +133,7 @@ pub(super) fn thin_plate(
             cycles(&w.plate.report_y),
         );
     }
-    let mut plates = instance.plates.lock().unwrap_or_else(|e| e.into_inner());
+    let mut plates = instance.plates.locked();
     plates.retain(|(t, k, _)| !(*t == time && *k == setup));
     if plates.len() >= PLATES_KEPT {
         plates.remove(0);
