@@ -17,7 +17,7 @@ use half::slice::HalfFloatSliceExt;
 use libdeflater::{CompressionLvl, Compressor};
 use rayon::prelude::*;
 
-use crate::host::HostError;
+use crate::error::HostError;
 use crate::plate::{rgba, ExrPrecision, Plate};
 
 /// The `compression` attribute's values for the two ZIP flavours.

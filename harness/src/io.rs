@@ -15,7 +15,7 @@ use morphfx::geom::RectI;
 use morphfx::image::Image;
 use rayon::prelude::*;
 
-use crate::host::HostError;
+use crate::error::HostError;
 use crate::plate::rgba;
 pub use crate::plate::{ExrPrecision, Plate};
 

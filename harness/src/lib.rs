@@ -3,6 +3,7 @@
 
 pub mod cli;
 pub mod commands;
+pub mod error;
 pub mod exr_zip;
 pub mod host;
 pub mod interrupt;

@@ -12,7 +12,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use crate::host::HostError;
+use crate::error::HostError;
 use crate::io::{self, OutputFormat, Plate};
 use crate::sync::Locked;
 

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use crate::host::HostError;
+use crate::error::HostError;
 
 /// `plate.####.exr` at frame 1001 → `plate.1001.exr`; a name without `#` is itself.
 pub fn frame_path(pattern: &str, frame: i64) -> PathBuf {
@@ -147,7 +147,7 @@ mod tests {
         ] {
             let err = parse_frames(spec).expect_err(spec);
             assert!(err.message.contains(why), "{spec}: {}", err.message);
-            assert_eq!(err.kind, crate::host::ErrorKind::BadInput);
+            assert_eq!(err.kind, crate::error::ErrorKind::BadInput);
         }
     }
 }

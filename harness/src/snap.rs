@@ -15,7 +15,7 @@ use morphfx::scene::Scene;
 use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 use serde_json::Value;
 
-use crate::host::HostError;
+use crate::error::HostError;
 use crate::io;
 use crate::sequence::{frame_path, is_sequence};
 

@@ -14,7 +14,7 @@ use morphfx::scene::Scene;
 use morphfx::track::{track_side, Frames, Grey, Pyramid, SideEstimate, SideKey, TrackSettings};
 use serde_json::{json, Value};
 
-use crate::host::HostError;
+use crate::error::HostError;
 use crate::io;
 use crate::pipeline::ReadAhead;
 use crate::progress::Progress;

@@ -17,9 +17,9 @@ use openfx::sys::image_effect_v1::time_line::kOfxTimeLineSuite;
 
 use super::checks::violation;
 use super::effect::{Effect, Message};
-use super::error::{HostError, BAD_INPUT_ID};
 use super::props::PropertySet;
 use super::{effect, guard, interact_suites, misuse, params, props, services};
+use crate::error::{HostError, BAD_INPUT_ID};
 use crate::sync::Locked;
 
 /// What a host offers beyond the basics.

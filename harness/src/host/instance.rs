@@ -11,10 +11,10 @@ use openfx::sys::image_effect_v1::param::*;
 
 use super::bundle::{accept, failure, Bundle};
 use super::effect::{Effect, FrameSource, Message};
-use super::error::HostError;
 use super::frame::{self, Frame};
 use super::params::{self, ParamValue};
 use super::props::PropertySet;
+use crate::error::HostError;
 use crate::sync::Locked;
 
 /// A new instance of `descriptor` in `context`: its params and clips copied

@@ -6,7 +6,6 @@ pub mod allocator;
 mod bundle;
 mod checks;
 pub mod effect;
-mod error;
 pub mod frame;
 pub mod guard;
 mod instance;
@@ -17,11 +16,11 @@ pub mod params;
 pub mod props;
 pub mod services;
 
+pub use crate::error::{ErrorKind, HostError, BAD_INPUT_ID};
 pub use bundle::{bundle_binary, Bundle, HostOptions, PluginInfo};
 #[cfg(test)]
 pub(crate) use checks::VIOLATION_TESTS;
 pub use checks::{host_failure, take_violations, violation};
 pub use effect::{take_unowned_messages, Effect, FrameSource, Message};
-pub use error::{ErrorKind, HostError, BAD_INPUT_ID};
 pub use frame::Frame;
 pub use instance::{Instance, OutputSpec};

@@ -1,4 +1,6 @@
-//! What a host run ends in when it does not succeed.
+//! What a `morphfx` run ends in when it does not succeed, whichever layer
+//! (frame IO, the host, a command) found the fault; its kind is the exit
+//! status.
 
 /// Message id the plugin uses for the user's mistakes.
 pub const BAD_INPUT_ID: &str = "net.morphfx.BadInput";
