@@ -696,3 +696,20 @@ fn write_other(
     };
     result.map_err(|e| HostError::failed(format!("cannot write: {e}")))
 }
+
+/// Writes `text` to `path` atomically: a temporary file in the same
+/// folder, renamed over the final name only when whole.
+pub fn write_text(path: &Path, text: &str) -> std::result::Result<(), HostError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
+    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            HostError::bad(format!("{}: cannot write: {e}", path.display()))
+        })
+}

@@ -13,6 +13,4 @@ pub mod plate;
 pub mod progress;
 pub mod raster;
 pub mod sequence;
-pub mod snap;
 pub mod sync;
-pub mod track;

@@ -5,12 +5,12 @@
 use clap::Parser;
 use morphfx::snake::SnakeSettings;
 use morphfx_harness::cli::{Cli, Command, JobKind};
+use morphfx_harness::commands::snap::Snap;
 use morphfx_harness::commands::{
     bench, demo, drag, find_bundle, job, openjd, overlay, params, plugins, track,
 };
 use morphfx_harness::host::{ErrorKind, HostError};
 use morphfx_harness::interrupt;
-use morphfx_harness::snap::Snap;
 
 fn main() {
     morphfx_harness::host::allocator::tune_for_frames();

@@ -12,6 +12,7 @@ pub mod param_value;
 pub mod params;
 pub mod plates;
 pub mod plugins;
+pub mod snap;
 pub mod track;
 
 use std::path::{Path, PathBuf};

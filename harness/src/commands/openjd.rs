@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::host::HostError;
+use crate::io::write_text;
 use crate::sequence::{openjd_frames, parse_frames};
-use crate::snap::write_atomically;
 
 const MORPH_TEMPLATE: &str = include_str!("../../../farm/openjd/morph.template.yaml");
 const WARP_TEMPLATE: &str = include_str!("../../../farm/openjd/warp.template.yaml");
@@ -55,9 +55,9 @@ pub fn write_bundle(
     let openjd = serde_json::to_string_pretty(&openjd).unwrap_or_default() + "\n";
     std::fs::create_dir_all(job.dir)
         .map_err(|e| HostError::bad(format!("{}: {e}", job.dir.display())))?;
-    write_atomically(&job.dir.join("template.yaml"), template)?;
-    write_atomically(&job.dir.join("parameter_values.yaml"), &deadline)?;
-    write_atomically(&job.dir.join(OPENJD_PARAMETERS), &openjd)?;
+    write_text(&job.dir.join("template.yaml"), template)?;
+    write_text(&job.dir.join("parameter_values.yaml"), &deadline)?;
+    write_text(&job.dir.join(OPENJD_PARAMETERS), &openjd)?;
     let dir = job.dir.display();
     println!("job bundle: {dir}");
     println!("  run it here:  openjd run {dir}/template.yaml -p file://{dir}/{OPENJD_PARAMETERS}");

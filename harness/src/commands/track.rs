@@ -4,9 +4,12 @@ use std::path::Path;
 
 use morphfx::track::TrackSettings;
 
+mod follow;
+
+use follow::Track;
+
 use crate::host::HostError;
 use crate::sequence::parse_frames;
-use crate::track::Track;
 
 /// `morphfx track`, its options checked.
 pub fn track_job(

@@ -114,7 +114,7 @@ impl Snap<'_> {
         // The result must be a valid scene before it replaces anything.
         Scene::parse(&out)
             .map_err(|e| HostError::failed(format!("refined scene is invalid: {e}")))?;
-        write_atomically(self.output, &out)?;
+        io::write_text(self.output, &out)?;
         println!(
             "snap: refined {refined} polyline/curve feature(s) on both images (largest move {moved:.2} px) -> {}",
             self.output.display()
@@ -181,21 +181,6 @@ pub fn to_json(points: &[Vec2]) -> Value {
             .map(|p| Value::from(vec![r(p.x), r(p.y)]))
             .collect::<Vec<_>>(),
     )
-}
-
-pub fn write_atomically(path: &Path, text: &str) -> Result<(), HostError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
-    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            HostError::bad(format!("{}: cannot write: {e}", path.display()))
-        })
 }
 
 /// A snake can pull two neighbouring samples onto one point (a tight

@@ -14,12 +14,12 @@ use morphfx::scene::Scene;
 use morphfx::track::{track_side, Frames, Grey, Pyramid, SideEstimate, SideKey, TrackSettings};
 use serde_json::{json, Value};
 
+use crate::commands::snap::to_json;
 use crate::error::HostError;
 use crate::io;
 use crate::pipeline::ReadAhead;
 use crate::progress::Progress;
 use crate::sequence::{frame_path, is_sequence};
-use crate::snap::to_json;
 
 /// What `track` was asked to do.
 pub struct Track<'a> {
@@ -301,7 +301,7 @@ impl Track<'_> {
         Scene::parse(&out)
             .map_err(|e| HostError::failed(format!("tracked scene is invalid: {e}")))?;
         match self.output {
-            Some(path) => crate::snap::write_atomically(path, &out),
+            Some(path) => io::write_text(path, &out),
             None => {
                 println!("{out}");
                 Ok(())
