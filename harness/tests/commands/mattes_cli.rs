@@ -366,24 +366,8 @@ fn mattes_without_alpha_act_by_their_mean() {
     for (matte, like) in [("rgb.png", "rgb-alpha.png"), ("grey.png", "grey-alpha.png")] {
         for role in ["--mask", "--timing"] {
             let render = |m: &str, out: &str| {
-                let out = d.join(out);
-                ok(&[
-                    "morph",
-                    "--line",
-                    LINE,
-                    "--a",
-                    s(&a),
-                    "--b",
-                    s(&b),
-                    "--t",
-                    "0.5",
-                    role,
-                    s(&d.join(m)),
-                    "--raw",
-                    "-o",
-                    s(&out),
-                ]);
-                read(&out, Colour::Raw)
+                let matte = d.join(m);
+                morph_line(&d, (&a, &b), "0.5", &[role, s(&matte), "--raw"], out)
             };
             let got = render(matte, "got.exr");
             let want = render(like, "want.exr");
@@ -404,23 +388,20 @@ fn mattes_without_alpha_act_by_their_mean() {
     }
 }
 
+/// `morphfx morph` of plates `a` and `b` by `LINE` at `t` with `extra`
+/// options into `out` in `d`, read back as written.
+fn morph_line(d: &Path, (a, b): (&Path, &Path), t: &str, extra: &[&str], out: &str) -> Image {
+    let out = d.join(out);
+    let mut args = vec!["morph", "--line", LINE, "--a", s(a), "--b", s(b), "--t", t];
+    args.extend_from_slice(extra);
+    args.extend(["-o", s(&out)]);
+    ok(&args);
+    read(&out, Colour::Raw)
+}
+
 /// The morph at t = 0.5 with no matte.
 fn render_without(d: &Path, a: &Path, b: &Path) -> Image {
-    let out = d.join("plain.exr");
-    ok(&[
-        "morph",
-        "--line",
-        LINE,
-        "--a",
-        s(a),
-        "--b",
-        s(b),
-        "--t",
-        "0.5",
-        "-o",
-        s(&out),
-    ]);
-    read(&out, Colour::Raw)
+    morph_line(d, (a, b), "0.5", &[], "plain.exr")
 }
 
 /// A timing matte keeps opaque plates opaque (its weights on A and B sum
@@ -441,25 +422,8 @@ fn a_timing_matte_keeps_plates_opaque_and_holds_a_to_the_edge() {
     io::write(&m, &Plate::new(matte, (W, H)), ExrPrecision::Float).unwrap();
     for t in ["0.3", "0.5"] {
         let render = |view: &str| {
-            let out = d.join(format!("{view}.exr"));
-            ok(&[
-                "morph",
-                "--line",
-                LINE,
-                "--a",
-                s(&a),
-                "--b",
-                s(&b),
-                "--t",
-                t,
-                "--timing",
-                s(&m),
-                "--view",
-                view,
-                "-o",
-                s(&out),
-            ]);
-            read(&out, Colour::Raw)
+            let out = format!("{view}.exr");
+            morph_line(&d, (&a, &b), t, &["--timing", s(&m), "--view", view], &out)
         };
         let (got, warped_a) = (render("morph"), render("warped-a"));
         for j in 0..H as i32 {
