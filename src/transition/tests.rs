@@ -218,35 +218,42 @@ fn geometry_rates_move_each_feature_point_at_its_own_pace() {
     }
 }
 
-#[test]
-fn colour_weights_carry_t0_to_b_through_w1() {
-    // A pixel showing the eye on both sides: A's weight is 1 − C(t) and
-    // B's is T1(b) = T0(W1(b)) = C(t), so the two sum to one there.
+/// The colour weights at t = 0.5 of pixels that see the given source
+/// points on A and on B (one pixel per pair), the features' curves pacing
+/// the colour: the eye at rate 0.1, the mouth by its own curve.
+fn weights_of(pixels: &[(Vec2, Vec2)]) -> Weights {
     let fs = features();
     let transition = TransitionSettings {
         geometry: Transition::Uniform,
         colour: Some(curves(Propagation::default())),
     };
     let s = settings(Method::Triangles, transition);
-    let t = 0.5;
-    let rates = s.colour_rates(&fs, t).unwrap();
+    let rates = s.colour_rates(&fs, 0.5).unwrap();
     let w1 = make_warp::toward(&fs, Side::A, 1.0, &s).unwrap();
-    let window = RectI::new(0, 0, 2, 1);
+    let window = RectI::new(0, 0, pixels.len() as i32, 1);
     let scale = PixelScale::new(1.0, 1.0, 1.0);
-    let eye = &fs[1];
-    let mouth = Vec2::new(90.0, 60.0);
-    // Two output pixels that see the given source positions.
-    let map = |p: Vec2, q: Vec2| {
-        let at = |v: Vec2| [v.x as f32, v.y as f32];
-        crate::image::WarpMap::new(window, scale, vec![at(p), at(q)])
+    let map = |side: fn(&(Vec2, Vec2)) -> Vec2| {
+        let at: Vec<[f32; 2]> = pixels
+            .iter()
+            .map(side)
+            .map(|v| [v.x as f32, v.y as f32])
+            .collect();
+        crate::image::WarpMap::new(window, scale, at)
     };
-    let map_a = map(eye.a[0], mouth);
-    let map_b = map(eye.b[0], fs[0].b[1]);
-    let w = colour_weights(&rates, &map_a, &map_b, w1.as_ref());
+    colour_weights(&rates, &map(|p| p.0), &map(|p| p.1), w1.as_ref())
+}
+
+#[test]
+fn colour_weights_carry_t0_to_b_through_w1() {
+    // A pixel showing the eye on both sides: A's weight is 1 − C(t) and
+    // B's is T1(b) = T0(W1(b)) = C(t), so the two sum to one there.
+    let fs = features();
+    let (eye, mouth) = (&fs[1], Vec2::new(90.0, 60.0));
+    let w = weights_of(&[(eye.a[0], eye.b[0]), (mouth, fs[0].b[1])]);
     let eye_rate = 0.1;
     assert!((w.a[0] as f64 - (1.0 - eye_rate)).abs() < 2e-3, "{:?}", w.a);
     assert!((w.b[0] as f64 - eye_rate).abs() < 2e-3, "{:?}", w.b);
-    let mouth_rate = Curve::new(&[(0.3, 0.8), (0.6, 0.9)], "m").unwrap().at(t);
+    let mouth_rate = Curve::new(&[(0.3, 0.8), (0.6, 0.9)], "m").unwrap().at(0.5);
     assert!((w.a[1] as f64 - (1.0 - mouth_rate)).abs() < 2e-3);
     assert!((w.b[1] as f64 - mouth_rate).abs() < 2e-3);
 }
@@ -258,20 +265,8 @@ fn colour_weights_sum_to_one_where_the_two_points_disagree() {
     // 1 − 0.1 and C(t), sum to more than 1; the dissolve keeps their ratio
     // and sums to 1, so opaque plates stay opaque.
     let fs = features();
-    let transition = TransitionSettings {
-        geometry: Transition::Uniform,
-        colour: Some(curves(Propagation::default())),
-    };
-    let s = settings(Method::Triangles, transition);
+    let w = weights_of(&[(fs[1].a[0], fs[0].b[1])]);
     let t = 0.5;
-    let rates = s.colour_rates(&fs, t).unwrap();
-    let w1 = make_warp::toward(&fs, Side::A, 1.0, &s).unwrap();
-    let window = RectI::new(0, 0, 1, 1);
-    let scale = PixelScale::new(1.0, 1.0, 1.0);
-    let at = |v: Vec2| vec![[v.x as f32, v.y as f32]];
-    let map_a = crate::image::WarpMap::new(window, scale, at(fs[1].a[0]));
-    let map_b = crate::image::WarpMap::new(window, scale, at(fs[0].b[1]));
-    let w = colour_weights(&rates, &map_a, &map_b, w1.as_ref());
     let mouth_rate = Curve::new(&[(0.3, 0.8), (0.6, 0.9)], "m").unwrap().at(t);
     let (pa, pb) = (1.0 - 0.1, mouth_rate);
     assert!(pa + pb > 1.5, "the paper's weights sum to {}", pa + pb);
