@@ -198,7 +198,7 @@ impl Crate {
                 .into_iter()
                 .filter(|u| !u.reexport)
                 .map(|u| u.path)
-                .chain(inline_paths(code));
+                .chain(inline_paths(code, &child_modules(code)));
             for path in paths {
                 if let Some((start, rest)) = self.start_of(module, &path) {
                     if let Some(target) = self.resolve(&start, rest, 0) {
@@ -223,20 +223,8 @@ struct Use {
 /// The paths of every `use` declaration in `code`, use trees expanded.
 fn uses(code: &str) -> Vec<Use> {
     let mut out = Vec::new();
-    let mut from = 0;
-    while let Some(i) = code[from..].find("use ") {
-        let at = from + i;
-        from = at + 4;
-        let line_start = code[..at].rfind('\n').map_or(0, |n| n + 1);
-        let head = code[line_start..at].trim();
-        let reexport = head == "pub"
-            || (head.starts_with("pub(") && head.ends_with(')') && !head.contains(' '));
-        if !(head.is_empty() || reexport) {
-            continue;
-        }
-        let Some(end) = code[at..].find(';') else {
-            break;
-        };
+    for (at, end, reexport) in use_declarations(code) {
+        let end = end - at;
         // `Name as Other` keeps `Name`: the renaming is marked before
         // white space goes.
         let tree: String = code[at + 4..at + end]
@@ -255,6 +243,29 @@ fn uses(code: &str) -> Vec<Use> {
                 .collect();
             out.push(Use { path, reexport });
         }
+    }
+    out
+}
+
+/// Where each `use` declaration of `code` lies: from its `use` to its
+/// `;`, and whether it re-exports (`pub use`, `pub(…) use`).
+fn use_declarations(code: &str) -> Vec<(usize, usize, bool)> {
+    let mut out = Vec::new();
+    let mut from = 0;
+    while let Some(i) = code[from..].find("use ") {
+        let at = from + i;
+        from = at + 4;
+        let line_start = code[..at].rfind('\n').map_or(0, |n| n + 1);
+        let head = code[line_start..at].trim();
+        let reexport = head == "pub"
+            || (head.starts_with("pub(") && head.ends_with(')') && !head.contains(' '));
+        if !(head.is_empty() || reexport) {
+            continue;
+        }
+        let Some(end) = code[at..].find(';') else {
+            break;
+        };
+        out.push((at, at + end, reexport));
         from = at + end;
     }
     out
@@ -289,19 +300,24 @@ fn expand(tree: &str) -> Vec<String> {
         .collect()
 }
 
-/// Paths written in code outside `use`: `crate::a::b`, `super::x`, `self::y`.
-fn inline_paths(code: &str) -> Vec<Vec<String>> {
+/// Paths written in code outside `use` declarations, wherever they stand
+/// (a field's type, a call, an expression): `crate::a::b`, `super::x`,
+/// `self::y`, and `child::z` for each of the file's child modules.
+fn inline_paths(code: &str, children: &[String]) -> Vec<Vec<String>> {
+    let declarations = use_declarations(code);
+    let in_use = |i: usize| declarations.iter().any(|&(a, b, _)| (a..b).contains(&i));
+    let starts = ["crate", "super", "self"]
+        .into_iter()
+        .chain(children.iter().map(String::as_str))
+        .map(|s| format!("{s}::"));
     let mut out = Vec::new();
-    for start in ["crate::", "super::", "self::"] {
-        for (i, _) in code.match_indices(start) {
+    for start in starts {
+        for (i, _) in code.match_indices(&start) {
             let before = code[..i].chars().last();
             if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == ':') {
                 continue;
             }
-            let line_start = code[..i].rfind('\n').map_or(0, |n| n + 1);
-            if code[line_start..i].trim_start().starts_with("use ")
-                || code[line_start..i].trim_start().starts_with("pub")
-            {
+            if in_use(i) {
                 continue;
             }
             let mut segs = Vec::new();
@@ -389,35 +405,37 @@ fn workspace() -> PathBuf {
 
 #[test]
 fn no_source_files_import_each_other_in_any_crate() {
-    let mut all = Vec::new();
+    let mut found = Vec::new();
     let mut imports = 0;
     for (dir, root) in CRATES {
         let c = Crate::load(&workspace().join(dir).join(root));
         let edges = c.edges();
         imports += edges.values().map(BTreeSet::len).sum::<usize>();
-        all.extend(cycles(&edges));
+        found.extend(cycles(&edges).into_iter().map(|g| describe(&g, &edges)));
     }
     assert!(imports > 300, "the scan found the imports ({imports})");
-    let text: Vec<String> = all
-        .iter()
-        .map(|group| {
-            group
-                .iter()
-                .map(|p| {
-                    p.strip_prefix(workspace())
-                        .unwrap_or(p)
-                        .display()
-                        .to_string()
-                })
-                .collect::<Vec<_>>()
-                .join(" <-> ")
-        })
-        .collect();
-    assert!(text.is_empty(), "import cycles:\n{}", text.join("\n"));
+    assert!(found.is_empty(), "import cycles:\n{}", found.join("\n"));
+}
+
+/// A loop's files and, under them, which of them imports which: what to
+/// cut to break it.
+fn describe(group: &[PathBuf], edges: &BTreeMap<PathBuf, BTreeSet<PathBuf>>) -> String {
+    let name = |p: &PathBuf| {
+        let p = p.strip_prefix(workspace()).unwrap_or(p);
+        p.display().to_string()
+    };
+    let mut text = group.iter().map(name).collect::<Vec<_>>().join(" <-> ");
+    for from in group {
+        for to in edges[from].iter().filter(|t| group.contains(t)) {
+            text += &format!("\n    {} imports {}", name(from), name(to));
+        }
+    }
+    text
 }
 
 /// The scan resolves what it must: a sibling import, a re-exported item
-/// followed to its defining file, and a known two-file loop in a made-up
+/// followed to its defining file, paths in a public field and through a
+/// child module, and a known two-file loop in a made-up
 /// crate found as one.
 #[test]
 fn the_scan_resolves_imports_and_finds_a_loop() {
@@ -425,14 +443,21 @@ fn the_scan_resolves_imports_and_finds_a_loop() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(dir.join("a")).unwrap();
     let write = |p: &str, s: &str| std::fs::write(dir.join(p), s).unwrap();
-    write("lib.rs", "mod a;\nmod c;\npub use a::Thing;\n");
+    write("lib.rs", "mod a;\nmod c;\nmod d;\npub use a::Thing;\n");
     write("a/mod.rs", "mod x;\nmod y;\npub use x::Thing;\n");
     write("a/x.rs", "use super::y::helper;\npub struct Thing;\n");
     write(
         "a/y.rs",
         "pub fn helper() {}\nfn f() { let _ = crate::Thing; }\n",
     );
-    write("c.rs", "use crate::a::Thing;\n");
+    write("c.rs", "use crate::a::Thing;\npub struct Q;\n");
+    // Paths outside `use`: a public field's type, a bare child module.
+    std::fs::create_dir_all(dir.join("d")).unwrap();
+    write(
+        "d/mod.rs",
+        "mod e;\npub struct S {\n    pub f: super::c::Q,\n}\nfn g() { e::run(); }\n",
+    );
+    write("d/e.rs", "pub fn run() {}\n");
     let c = Crate::load(&dir.join("lib.rs"));
     let edges = c.edges();
     let e = |from: &str, to: &str| edges[&dir.join(from)].contains(&dir.join(to));
@@ -440,6 +465,11 @@ fn the_scan_resolves_imports_and_finds_a_loop() {
     assert!(e("a/y.rs", "a/x.rs"), "crate::Thing is defined in a/x.rs");
     assert!(e("c.rs", "a/x.rs"));
     assert!(!e("lib.rs", "a/x.rs"), "a re-export is not an import");
+    assert!(e("d/mod.rs", "c.rs"), "a field's type is an import");
+    assert!(
+        e("d/mod.rs", "d/e.rs"),
+        "a call through a child module is one"
+    );
     let found = cycles(&edges);
     assert_eq!(found, vec![vec![dir.join("a/x.rs"), dir.join("a/y.rs")]]);
     let _ = std::fs::remove_dir_all(&dir);

@@ -8,7 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{exit, Command, Output};
 
-use crate::{root, target_dir, tools};
+use crate::tools;
+use crate::workspace::{root, target_dir};
 
 /// The reference runtime, pinned: what this check was written against.
 const OPENJD: [&str; 3] = [

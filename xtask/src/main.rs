@@ -9,13 +9,9 @@ use std::process::{exit, Command};
 mod farm;
 mod refhost;
 mod tools;
+mod workspace;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("xtask lives in the workspace")
-        .to_path_buf()
-}
+use workspace::{root, target_dir};
 
 /// `cargo run ... --bin morphfx -- --bundle BUNDLE`, ready for a subcommand.
 fn morphfx(release: bool, bundle: &Path) -> Command {
@@ -41,12 +37,6 @@ fn cargo(args: &[&str]) {
     let mut c = cargo_command();
     c.args(args);
     run_cargo(c);
-}
-
-fn target_dir() -> PathBuf {
-    std::env::var("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| root().join("target"))
 }
 
 /// `cargo build --package morphfx-ofx`, for baseline x86-64 or, with

@@ -7,7 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{exit, Command};
 
-use crate::{root, target_dir, tools};
+use crate::tools;
+use crate::workspace::{root, target_dir};
 
 /// The crate whose package holds the openfx tree (HostSupport included).
 const OPENFX_SYS: &str = "openfx-sys-0.1.0";

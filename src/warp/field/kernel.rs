@@ -5,8 +5,8 @@
 
 use wide::f32x8;
 
+use super::lines::LinePair;
 use super::weight::{Exponent, Weight};
-use super::LinePair;
 
 #[derive(Debug, Clone, Default)]
 pub(super) struct Lines {

@@ -1,6 +1,6 @@
 //! Features as Beier-Neely line pairs, and lines interpolated over `t`.
 
-use super::{FieldSettings, LineInterpolation};
+use super::settings::{FieldSettings, LineInterpolation};
 use crate::features::{Feature, FeatureKind, Side, Tween};
 use crate::geom::Vec2;
 

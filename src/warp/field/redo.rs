@@ -14,9 +14,11 @@
 use std::sync::Arc;
 
 use super::kernel::Lines;
+use super::lines::LinePair;
+use super::settings::Evaluation;
 use super::split::{fill_band, Band, Setup};
+use super::warp::FieldWarp;
 use super::weight::Weight;
-use super::{Evaluation, FieldWarp, LinePair};
 use crate::geom::{PixelScale, RectI};
 use crate::image::WarpMap;
 

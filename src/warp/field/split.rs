@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 use super::kernel::{Lines, Sums};
-use super::FieldWarp;
+use super::warp::FieldWarp;
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
 
