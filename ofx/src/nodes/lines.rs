@@ -4,10 +4,10 @@
 use morphfx::features::Side;
 use morphfx::geom::Vec2;
 
+use super::kind::NodeKind;
 use super::params::{
     slot_clear, slot_group, slot_ids, spec, Id, Point, Reader, SlotIds, LINE_COUNT, LINE_SLOTS,
 };
-use super::NodeKind;
 use crate::wrapper::params::Params;
 use crate::wrapper::spec::Kind;
 use crate::wrapper::Outcome;
@@ -73,7 +73,7 @@ pub fn slot_lines(r: &Reader<'_>) -> Vec<SlotLine> {
 /// Clears slot `k`: its ends lose their keys and go back to their
 /// defaults, and it is turned off; a trailing run of disabled slots leaves
 /// Line Count. One undo step.
-pub fn clear(kind: NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
+pub fn clear(kind: &'static NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
     let enable = slot_ids(k).enable;
     params.edit_block(&format!("Clear Line {k}"), || {
         for side in [Side::A, Side::B] {
@@ -97,7 +97,7 @@ pub fn clear(kind: NodeKind, params: &Params, k: usize, time: f64) -> Outcome {
     Ok(())
 }
 
-fn default_point(kind: NodeKind, id: &Id<Point>) -> (f64, f64) {
+fn default_point(kind: &'static NodeKind, id: &Id<Point>) -> (f64, f64) {
     match spec(kind, id.name()).map(|p| &p.kind) {
         Some(Kind::Point { default }) => *default,
         _ => (0.0, 0.0),
@@ -106,7 +106,7 @@ fn default_point(kind: NodeKind, id: &Id<Point>) -> (f64, f64) {
 
 /// Shows the slots up to Line Count and hides the rest. Best effort: a
 /// host that cannot hide params shows them all, which is only untidy.
-pub fn hide_unused(kind: NodeKind, params: &Params, time: f64) {
+pub fn hide_unused(kind: &'static NodeKind, params: &Params, time: f64) {
     let count = Reader::new(params, kind, time).int(&LINE_COUNT).max(0) as usize;
     for k in 1..=LINE_SLOTS {
         let secret = k > count;

@@ -11,7 +11,7 @@ use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 
 use super::overlay::shapes;
 use super::params::{slot_ids, Reader, Settings, SlotIds, LINE_COUNT, SNAP_SIGMA};
-use super::NodeState;
+use super::state::NodeState;
 use crate::wrapper::clips::{Depth, EffectHandle};
 use crate::wrapper::{Failure, Outcome};
 

@@ -11,14 +11,15 @@ use morphfx::warp::auto::{Correspondence, Grid};
 use morphfx::warp::field::FieldMap;
 use morphfx::warp::thin_plate::ThinPlate;
 
-use super::NodeKind;
+use super::kind::NodeKind;
+use super::overlay::State as OverlayState;
 use crate::cache::{Cache, Key, WarpCache};
 use crate::sync::Locked;
 use crate::wrapper::params::Params;
 use crate::wrapper::plugin::Context;
 
 pub struct NodeState {
-    pub kind: NodeKind,
+    pub kind: &'static NodeKind,
     /// The context the host made the instance in.
     pub context: Context,
     /// The instance's params, their handles fetched once at creation.
@@ -49,7 +50,7 @@ pub struct NodeState {
     /// like the warps they come from.
     pub weights: Cache<Weights>,
     /// The viewer overlay's hover, drag and held keys.
-    pub overlay: Mutex<super::overlay::State>,
+    pub overlay: Mutex<OverlayState>,
 }
 
 /// Solved grids kept for warm starts.
@@ -62,10 +63,8 @@ pub const PLATES_KEPT: usize = 4;
 pub const PLANES_KEPT: usize = 2;
 
 impl NodeState {
-    /// A new instance's state over its params; the line slots past Line
-    /// Count hidden.
-    pub fn create(kind: NodeKind, context: Context, params: Params) -> NodeState {
-        super::lines::hide_unused(kind, &params, 0.0);
+    /// A new instance's state over its params.
+    pub fn create(kind: &'static NodeKind, context: Context, params: Params) -> NodeState {
         NodeState {
             kind,
             context,

@@ -18,10 +18,11 @@ use morphfx::track::{Grey, Pyramid, SideTracker, TrackSettings};
 
 use morphfx::scene::edit::Document;
 
+use super::kind::NodeKind;
 use super::lines::{end_id, slot_lines, SlotLine};
 use super::overlay::shapes;
 use super::params::{Reader, Settings};
-use super::{NodeKind, NodeState};
+use super::state::NodeState;
 use crate::wrapper::clips::{Depth, EffectHandle};
 use crate::wrapper::params::Params;
 use crate::wrapper::plugin::Context;
@@ -163,7 +164,7 @@ type ShapeKey = (f64, usize, Side, Vec<Vec2>);
 
 /// The node's sources with their sides and frame offsets, each connected.
 fn sources<'e>(
-    (kind, context): (NodeKind, Context),
+    (kind, context): (&'static NodeKind, Context),
     effect: &'e EffectHandle,
     params: &Params,
     time: f64,

@@ -1,20 +1,36 @@
 //! The Warp node: one source warped toward the features' positions at `t`
 //! (t = 1 lands A's features on B's positions). Filter and general contexts.
 
-use std::ffi::CStr;
+use morphfx::make_warp::Method;
+use morphfx::views::View;
 
-use super::{Node, NodeKind, NodeState};
+use super::kind::{NodeKind, Sources};
+use super::node::Node;
+use super::state::NodeState;
 use crate::wrapper::plugin::Context;
 
 pub struct Warp(NodeState);
 
 impl Node for Warp {
-    const KIND: NodeKind = NodeKind::Warp;
-    const ID: &'static CStr = c"net.morphfx.Warp";
-    const LABEL: &'static str = "MorphFX Warp";
-    const DESCRIPTION: &'static str =
-        "Warps one image so its features (A positions) move toward their B positions by progress t.";
-    const CONTEXTS: &'static [Context] = &[Context::Filter, Context::General];
+    const KIND: &'static NodeKind = &NodeKind {
+        id: c"net.morphfx.Warp",
+        label: "MorphFX Warp",
+        description: "Warps one image so its features (A positions) move toward their B positions by progress t.",
+        contexts: &[Context::Filter, Context::General],
+        sources: Sources::One("Source"),
+        timing_matte: false,
+        // Every method but auto, which finds its warp from two pictures.
+        methods: &[
+            Method::Field,
+            Method::Mesh,
+            Method::Triangles,
+            Method::ThinPlate,
+            Method::Mffd,
+            Method::Hybrid,
+        ],
+        views: &[View::WarpedA, View::StmapA, View::Grid, View::Folds],
+        view_labels: &[(View::WarpedA, "warped"), (View::StmapA, "stmap")],
+    };
     fn new(state: NodeState) -> Self {
         Warp(state)
     }
@@ -22,5 +38,3 @@ impl Node for Warp {
         &self.0
     }
 }
-
-pub const SOURCE_CLIP: &str = "Source";

@@ -2,7 +2,7 @@
 
 use std::ffi::{c_void, CStr, CString};
 
-use morphfx::geom::{RectD, RectI, Vec2};
+use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
 use morphfx::image::{ImageView, Layout, RowsMut, Sample};
 use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::image_effect::*;
@@ -386,6 +386,13 @@ pub struct ImageInfo {
     pub premultiplied: bool,
     pub par: f64,
     pub render_scale: (f64, f64),
+}
+
+impl ImageInfo {
+    /// Canonical units per pixel: the render scale and the pixel aspect.
+    pub fn pixel_scale(&self) -> PixelScale {
+        PixelScale::new(self.render_scale.0, self.render_scale.1, self.par)
+    }
 }
 
 impl Default for ImageInfo {

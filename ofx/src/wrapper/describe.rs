@@ -63,12 +63,15 @@ pub(super) fn describe<E: ImageEffect>(effect: &EffectHandle) -> Outcome {
         0,
         sequential_value(caps.sequential),
     );
-    // The viewer overlay: OpenGL (V1) for every host that draws overlays,
-    // the Draw suite entry (V2) only where the host offers that suite.
-    let entry = interact::main_entry::<E> as *mut c_void;
-    let _ = p.set_pointer(kOfxImageEffectPluginPropOverlayInteractV1, 0, entry);
-    if host::suites().is_ok_and(|s| s.draw.is_some()) {
-        let _ = p.set_pointer(kOfxImageEffectPluginPropOverlayInteractV2, 0, entry);
+    // The viewer overlay, where the effect has one: OpenGL (V1) for every
+    // host that draws overlays, the Draw suite entry (V2) only where the
+    // host offers that suite.
+    if E::OVERLAY.is_some() {
+        let entry = interact::main_entry::<E> as *mut c_void;
+        let _ = p.set_pointer(kOfxImageEffectPluginPropOverlayInteractV1, 0, entry);
+        if host::suites().is_ok_and(|s| s.draw.is_some()) {
+            let _ = p.set_pointer(kOfxImageEffectPluginPropOverlayInteractV2, 0, entry);
+        }
     }
     Ok(())
 }

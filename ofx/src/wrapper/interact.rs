@@ -17,7 +17,7 @@ use super::attach::attachment;
 use super::clips::EffectHandle;
 use super::draw::DrawSuitePainter;
 use super::gl::GlPainter;
-use super::plugin::{DrawArgs, ImageEffect, Overlay, Pen};
+use super::plugin::{DrawArgs, ImageEffect, OverlayActions, Pen};
 use super::props::PropSet;
 use super::{host, Failure, Outcome, Reply};
 
@@ -81,11 +81,16 @@ unsafe fn run<E: ImageEffect>(
     if action == kOfxActionDescribe || action == kOfxActionDestroyInstance {
         return Ok(Reply::Done);
     }
+    // Described only for effects with an overlay; a host that calls
+    // anyway is left to its default.
+    let Some(overlay) = E::OVERLAY else {
+        return Ok(Reply::Default);
+    };
     // SAFETY: the caller's interact handle.
     let props = unsafe { props_of(suite, interact)? };
     if action == kOfxActionCreateInstance {
         // Redraw when any param the overlay shows changes.
-        let ids = E::Overlay::slave_params();
+        let ids = (overlay.slave_params)();
         let _ = props.set_strings(
             kOfxInteractPropSlaveToParam,
             &ids.iter().map(String::as_str).collect::<Vec<_>>(),
@@ -104,17 +109,17 @@ unsafe fn run<E: ImageEffect>(
     let time = args.get_double(kOfxPropTime, 0)?;
     if action == kOfxInteractActionDraw {
         // SAFETY: `args` are the draw action's, read during it.
-        return unsafe { draw::<E>(node, &effect, &args, time) };
+        return unsafe { draw(&overlay, node, &effect, &args, time) };
     }
     if action == kOfxInteractActionKeyDown || action == kOfxInteractActionKeyRepeat {
         let sym = args.get_int(kOfxPropKeySym, 0)?;
-        return E::Overlay::key_down(node, &effect, sym, time);
+        return (overlay.key_down)(node, &effect, sym, time);
     }
     if action == kOfxInteractActionKeyUp {
-        return E::Overlay::key_up(node, &effect, args.get_int(kOfxPropKeySym, 0)?);
+        return (overlay.key_up)(node, &effect, args.get_int(kOfxPropKeySym, 0)?);
     }
     if action == kOfxInteractActionLoseFocus {
-        return E::Overlay::lose_focus(node, &effect);
+        return (overlay.lose_focus)(node, &effect);
     }
     let pen = || -> Outcome<Pen> {
         let [x, y] = args.get_doubles::<2>(kOfxInteractPropPenPosition)?;
@@ -125,7 +130,7 @@ unsafe fn run<E: ImageEffect>(
         })
     };
     if action == kOfxInteractActionPenDown {
-        E::Overlay::pen_down(node, &effect, pen()?)
+        (overlay.pen_down)(node, &effect, pen()?)
     } else if action == kOfxInteractActionPenMotion {
         let mut redraw = || {
             if let Some(f) = suite.interactRedraw {
@@ -133,9 +138,9 @@ unsafe fn run<E: ImageEffect>(
                 unsafe { f(interact) };
             }
         };
-        E::Overlay::pen_motion(node, &effect, pen()?, &mut redraw)
+        (overlay.pen_motion)(node, &effect, pen()?, &mut redraw)
     } else if action == kOfxInteractActionPenUp {
-        E::Overlay::pen_up(node, &effect, pen()?)
+        (overlay.pen_up)(node, &effect, pen()?)
     } else {
         Ok(Reply::Default)
     }
@@ -182,7 +187,8 @@ fn pixel_scale(args: &PropSet) -> (f64, f64) {
 
 /// # Safety
 /// `args` are the running draw action's arguments.
-unsafe fn draw<E: ImageEffect>(
+unsafe fn draw<E>(
+    overlay: &OverlayActions<E>,
     node: &E,
     effect: &EffectHandle,
     args: &PropSet,
@@ -201,7 +207,7 @@ unsafe fn draw<E: ImageEffect>(
             pixel,
             measured: false,
         };
-        return E::Overlay::draw(node, effect, &args, &mut painter);
+        return (overlay.draw)(node, effect, &args, &mut painter);
     }
     match GlPainter::new(pixel) {
         Some(mut painter) => {
@@ -210,7 +216,7 @@ unsafe fn draw<E: ImageEffect>(
                 pixel: painter.pixel(),
                 measured: true,
             };
-            E::Overlay::draw(node, effect, &args, &mut painter)
+            (overlay.draw)(node, effect, &args, &mut painter)
         }
         // No Draw suite and no GL context: nothing to draw with.
         None => Ok(Reply::Done),

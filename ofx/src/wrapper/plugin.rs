@@ -167,7 +167,9 @@ impl ClipPreferences {
 }
 
 /// An OFX image effect. One type per plugin of the bundle; its instances
-/// are values of the type, made in `create` and dropped at destroy.
+/// are values of the type, made in `create` and dropped at destroy. What
+/// an effect does not answer is left to the host's default behaviour, as
+/// the spec defines it for each action (`kOfxStatReplyDefault`).
 pub trait ImageEffect: Sized + Send + Sync + 'static {
     /// The plugin identifier, reverse-domain style.
     const ID: &'static CStr;
@@ -179,8 +181,9 @@ pub trait ImageEffect: Sized + Send + Sync + 'static {
     const GROUPING: &'static str;
     const CONTEXTS: &'static [Context];
     const CAPABILITIES: Capabilities;
-    /// The viewer overlay.
-    type Overlay: Overlay<Self>;
+    /// The viewer overlay, if the effect draws one:
+    /// `Some(OverlayActions::of::<TheOverlay>())`.
+    const OVERLAY: Option<OverlayActions<Self>> = None;
 
     /// The clips and params of a context.
     fn describe_in_context(context: Context) -> ContextSpec;
@@ -188,35 +191,51 @@ pub trait ImageEffect: Sized + Send + Sync + 'static {
     /// An instance, its params bound to the host's.
     fn create(effect: &EffectHandle, context: Context, params: Params) -> Outcome<Self>;
 
+    fn render(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome;
+
     /// Frees what the instance caches.
     fn purge(&self) {}
 
     /// The output's region of definition; `None` leaves it to the host's default.
-    fn region_of_definition(&self, effect: &EffectHandle, time: f64) -> Outcome<Option<RectD>>;
+    fn region_of_definition(&self, _effect: &EffectHandle, _time: f64) -> Outcome<Option<RectD>> {
+        Ok(None)
+    }
 
     /// Each input's region needed to render the output at `time`.
     fn regions_of_interest(
         &self,
-        effect: &EffectHandle,
-        time: f64,
-        out: &mut Rois,
-    ) -> Outcome<Reply>;
+        _effect: &EffectHandle,
+        _time: f64,
+        _out: &mut Rois,
+    ) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
 
     fn frames_needed(
         &self,
-        effect: &EffectHandle,
-        time: f64,
-        out: &mut FramesNeeded,
-    ) -> Outcome<Reply>;
+        _effect: &EffectHandle,
+        _time: f64,
+        _out: &mut FramesNeeded,
+    ) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
 
-    fn clip_preferences(&self, effect: &EffectHandle, out: &mut ClipPreferences) -> Outcome<Reply>;
+    fn clip_preferences(
+        &self,
+        _effect: &EffectHandle,
+        _out: &mut ClipPreferences,
+    ) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
 
     /// The source the output equals unchanged, if any.
-    fn is_identity(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome<Option<Identity>>;
+    fn is_identity(&self, _effect: &EffectHandle, _args: &RenderArgs) -> Outcome<Option<Identity>> {
+        Ok(None)
+    }
 
-    fn render(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome;
-
-    fn param_changed(&self, effect: &EffectHandle, change: &ParamChange) -> Outcome;
+    fn param_changed(&self, _effect: &EffectHandle, _change: &ParamChange) -> Outcome {
+        Ok(())
+    }
 }
 
 /// A pen event: when, where (canonical), and the view's canonical units
@@ -242,27 +261,72 @@ pub struct DrawArgs {
     pub measured: bool,
 }
 
-/// A node's viewer overlay: its actions on an instance of node `E`.
+/// A viewer overlay: its actions on an instance of effect `E`. Only
+/// drawing is required; what the overlay does not handle is left to the
+/// host.
 pub trait Overlay<E>: 'static {
     /// Params whose changes redraw the overlay.
-    fn slave_params() -> Vec<String>;
+    fn slave_params() -> Vec<String> {
+        Vec::new()
+    }
     fn draw(
         node: &E,
         effect: &EffectHandle,
         args: &DrawArgs,
         painter: &mut dyn Painter,
     ) -> Outcome<Reply>;
-    fn pen_down(node: &E, effect: &EffectHandle, pen: Pen) -> Outcome<Reply>;
+    fn pen_down(_node: &E, _effect: &EffectHandle, _pen: Pen) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
     /// `redraw` asks the host to draw the overlay again.
     fn pen_motion(
-        node: &E,
-        effect: &EffectHandle,
-        pen: Pen,
-        redraw: &mut dyn FnMut(),
-    ) -> Outcome<Reply>;
-    fn pen_up(node: &E, effect: &EffectHandle, pen: Pen) -> Outcome<Reply>;
+        _node: &E,
+        _effect: &EffectHandle,
+        _pen: Pen,
+        _redraw: &mut dyn FnMut(),
+    ) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
+    fn pen_up(_node: &E, _effect: &EffectHandle, _pen: Pen) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
     /// A key pressed (or repeating): its OFX key symbol (see `keys`).
-    fn key_down(node: &E, effect: &EffectHandle, key: i32, time: f64) -> Outcome<Reply>;
-    fn key_up(node: &E, effect: &EffectHandle, key: i32) -> Outcome<Reply>;
-    fn lose_focus(node: &E, effect: &EffectHandle) -> Outcome<Reply>;
+    fn key_down(_node: &E, _effect: &EffectHandle, _key: i32, _time: f64) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
+    fn key_up(_node: &E, _effect: &EffectHandle, _key: i32) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
+    fn lose_focus(_node: &E, _effect: &EffectHandle) -> Outcome<Reply> {
+        Ok(Reply::Default)
+    }
+}
+
+/// An overlay's actions on effect `E`, as the layer calls them: what
+/// [`ImageEffect::OVERLAY`] holds.
+pub struct OverlayActions<E> {
+    pub(super) slave_params: fn() -> Vec<String>,
+    pub(super) draw: fn(&E, &EffectHandle, &DrawArgs, &mut dyn Painter) -> Outcome<Reply>,
+    pub(super) pen_down: fn(&E, &EffectHandle, Pen) -> Outcome<Reply>,
+    pub(super) pen_motion: fn(&E, &EffectHandle, Pen, &mut dyn FnMut()) -> Outcome<Reply>,
+    pub(super) pen_up: fn(&E, &EffectHandle, Pen) -> Outcome<Reply>,
+    pub(super) key_down: fn(&E, &EffectHandle, i32, f64) -> Outcome<Reply>,
+    pub(super) key_up: fn(&E, &EffectHandle, i32) -> Outcome<Reply>,
+    pub(super) lose_focus: fn(&E, &EffectHandle) -> Outcome<Reply>,
+}
+
+impl<E> OverlayActions<E> {
+    /// Overlay `O`'s actions.
+    pub const fn of<O: Overlay<E>>() -> Self {
+        OverlayActions {
+            slave_params: O::slave_params,
+            draw: O::draw,
+            pen_down: O::pen_down,
+            pen_motion: O::pen_motion,
+            pen_up: O::pen_up,
+            key_down: O::key_down,
+            key_up: O::key_up,
+            lose_focus: O::lose_focus,
+        }
+    }
 }

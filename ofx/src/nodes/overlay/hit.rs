@@ -5,29 +5,11 @@
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
 
-use super::outline::{per_span, Outline, Owner};
+use super::outline::{per_span, Outline};
+use super::state::{Handle, Part};
 
 /// How close (screen pixels) the pen must come to grab.
 pub const RADIUS_PX: f64 = 8.0;
-
-/// Which part of a feature the pen holds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Part {
-    /// Control point `i` (a line's start is 0, its end 1).
-    Point(usize),
-    /// The body, in span `span` at its parameter `s` in `[0, 1]`: dragging
-    /// moves the whole feature; a polyline or curve tool inserts a point.
-    Body { span: usize, s: f64 },
-}
-
-/// A grabbable part of one feature on one side.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Handle {
-    pub owner: Owner,
-    /// A's position or B's.
-    pub side: Side,
-    pub part: Part,
-}
 
 /// The handle nearest `pen` within [`RADIUS_PX`] among `sides` of the
 /// editable `outlines`: points before bodies (a point sits on its body),
@@ -92,6 +74,7 @@ fn nearest_on_chain(
 
 #[cfg(test)]
 mod tests {
+    use super::super::state::Owner;
     use super::*;
     use morphfx::features::Feature;
 

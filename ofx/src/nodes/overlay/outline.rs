@@ -6,22 +6,12 @@ use morphfx::features::{Feature, FeatureKind, Side, Tween};
 use morphfx::geom::Vec2;
 use morphfx::warp::field::{line_pairs_toward, FieldSettings};
 
+use super::state::Owner;
 use crate::nodes::lines::SlotLine;
 
 /// Samples per curve span drawn and hit-tested: smooth at any zoom a
 /// compositor works at, and cheap (60 shapes × 20 points: 19k samples).
 pub const CURVE_SAMPLES: usize = 8;
-
-/// Where a feature lives, which says how an edit reaches it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Owner {
-    /// Line slot `k` (from 1): its params.
-    Slot(usize),
-    /// Feature `i` of Scene Text: edited in the text.
-    Shape(usize),
-    /// Feature `i` of Scene File: drawn, never edited.
-    File(usize),
-}
 
 /// One feature as the overlay sees it at a time.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,8 +4,8 @@
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
 
-use super::hit::{Handle, Part};
 use super::outline::{per_span, Outline};
+use super::state::{Handle, Owner, Part};
 use crate::nodes::params::Show;
 use crate::wrapper::paint::{Painter, Stipple, LABEL_PX};
 
@@ -270,7 +270,7 @@ impl Pen<'_> {
         let shapes = frame
             .outlines
             .iter()
-            .filter(|o| matches!(o.owner, super::outline::Owner::Shape(_)));
+            .filter(|o| matches!(o.owner, Owner::Shape(_)));
         let corner = shapes
             .flat_map(|o| o.feature.a.iter().chain(&o.feature.b))
             .fold(None, |m: Option<Vec2>, p| {

@@ -7,19 +7,23 @@
 use morphfx::features::{Feature, FeatureKind, Side};
 use morphfx::geom::Vec2;
 
-use super::hit::{self, Handle, Part};
-use super::outline::Owner;
+use super::hit;
+
 use super::shapes::{self, refused};
-use super::{editable, pixel_of, view, Building, Drag, MIN_NEW_LINE_PX};
+use super::state::{editable, pixel_of, Building, Drag, Handle, Owner, Part};
+use super::view::view;
 use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
 use crate::nodes::params::{OVERLAY_EDIT, OVERLAY_SHOW};
-use crate::nodes::NodeState;
+use crate::nodes::state::NodeState;
 use crate::sync::Locked;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::params::Params;
 use crate::wrapper::plugin::Pen;
 use crate::wrapper::{keys, Failure, Outcome, Reply};
+
+/// Shortest new line kept, in screen pixels: a click is not a line.
+const MIN_NEW_LINE_PX: f64 = 3.0;
 
 /// Pen down: a click of a shape being drawn, else a grab of what is under
 /// the pen, else the draw tool's new feature.

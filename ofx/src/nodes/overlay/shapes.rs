@@ -5,7 +5,7 @@
 use morphfx::scene::edit::Document;
 
 use crate::nodes::params::{Reader, SCENE_FILE, SCENE_TEXT};
-use crate::nodes::NodeState;
+use crate::nodes::state::NodeState;
 use crate::sync::Locked;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::{Failure, Outcome};

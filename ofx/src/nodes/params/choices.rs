@@ -1,11 +1,7 @@
 //! The options of the nodes' choice params, in the order hosts save them.
 
 use morphfx::choice::Choice;
-use morphfx::make_warp::Method;
 use morphfx::transition::procedural::PatternKind;
-use morphfx::views::View;
-
-use crate::nodes::NodeKind;
 
 /// What the viewer overlay shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,32 +80,6 @@ impl Choice for DrawTool {
             DrawTool::Polyline => "polyline",
             DrawTool::Curve => "curve",
         }
-    }
-}
-
-/// The methods a node offers, in choice order (hosts save the index: only
-/// ever append). Auto finds its warp from both pictures, so the Warp node,
-/// which has one, stops before it; auto is last, so no index moves.
-pub(super) fn methods(kind: NodeKind) -> &'static [Method] {
-    match kind {
-        NodeKind::Morph => Method::ALL,
-        NodeKind::Warp => &Method::ALL[..Method::ALL.len() - 1],
-    }
-}
-
-/// The views a node offers, in the order of its View choice.
-pub fn views(kind: NodeKind) -> &'static [View] {
-    match kind {
-        NodeKind::Morph => View::ALL,
-        NodeKind::Warp => &[View::WarpedA, View::StmapA, View::Grid, View::Folds],
-    }
-}
-
-pub(super) fn view_label(kind: NodeKind, v: View) -> &'static str {
-    match (kind, v) {
-        (NodeKind::Warp, View::WarpedA) => "warped",
-        (NodeKind::Warp, View::StmapA) => "stmap",
-        _ => v.name(),
     }
 }
 

@@ -5,7 +5,7 @@ use std::cell::RefCell;
 use morphfx::choice::Choice;
 use morphfx::geom::Vec2;
 
-use crate::nodes::NodeKind;
+use crate::nodes::kind::NodeKind;
 use crate::wrapper::params::Params;
 use crate::wrapper::spec::{Kind, ParamSpec};
 use crate::wrapper::Outcome;
@@ -19,14 +19,14 @@ use super::table::spec;
 pub struct Reader<'a> {
     /// `None`: every param at its default.
     pub(super) params: Option<&'a Params>,
-    pub(super) kind: NodeKind,
+    pub(super) kind: &'static NodeKind,
     pub(super) time: f64,
     pub(super) missing: RefCell<Vec<String>>,
     pub(super) unreadable: RefCell<Vec<String>>,
 }
 
 impl<'a> Reader<'a> {
-    pub fn new(params: &'a Params, kind: NodeKind, time: f64) -> Self {
+    pub fn new(params: &'a Params, kind: &'static NodeKind, time: f64) -> Self {
         Reader {
             params: Some(params),
             kind,

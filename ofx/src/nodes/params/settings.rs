@@ -12,10 +12,10 @@ use morphfx::warp::mesh::MeshSettings;
 use morphfx::warp::mffd::MffdSettings;
 use morphfx::warp::thin_plate::ThinPlateSettings;
 
-use crate::nodes::NodeKind;
+use crate::nodes::kind::NodeKind;
 use crate::wrapper::params::Params;
 
-use super::choices::{methods, views, Affects, EvaluationMode, PATTERNS};
+use super::choices::{Affects, EvaluationMode, PATTERNS};
 use super::ids::*;
 use super::reader::Reader;
 
@@ -51,13 +51,13 @@ pub struct Settings {
 }
 
 impl Settings {
-    pub fn read(params: &Params, time: f64, kind: NodeKind) -> Settings {
+    pub fn read(params: &Params, time: f64, kind: &'static NodeKind) -> Settings {
         Settings::read_with(Reader::new(params, kind, time), kind)
     }
 
     /// Every param at the default its table entry declares.
     #[cfg(test)]
-    pub fn defaults(kind: NodeKind) -> Settings {
+    pub fn defaults(kind: &'static NodeKind) -> Settings {
         let reader = Reader {
             params: None,
             kind,
@@ -68,16 +68,17 @@ impl Settings {
         Settings::read_with(reader, kind)
     }
 
-    fn read_with(r: Reader<'_>, kind: NodeKind) -> Settings {
+    fn read_with(r: Reader<'_>, kind: &'static NodeKind) -> Settings {
         let warp = MethodSettings {
-            method: r.pick(&METHOD, methods(kind)),
+            method: r.pick(&METHOD, kind.methods),
             field: field_settings(&r),
             mesh: MeshSettings {
                 pass: r.choice(&MESH_PASS),
             },
-            auto: match kind {
-                NodeKind::Morph => auto_settings(&r),
-                NodeKind::Warp => AutoSettings::default(),
+            auto: if kind.has_auto() {
+                auto_settings(&r)
+            } else {
+                AutoSettings::default()
             },
             thin_plate: ThinPlateSettings {
                 alpha: r.double(&PLATE_ALPHA),
@@ -100,14 +101,10 @@ impl Settings {
             scene_file: r.text(&SCENE_FILE),
             scene_text: r.text(&SCENE_TEXT),
             offset_a: r.int(&OFFSET_A),
-            offset_b: if kind == NodeKind::Morph {
-                r.int(&OFFSET_B)
-            } else {
-                0
-            },
+            offset_b: if kind.has_b() { r.int(&OFFSET_B) } else { 0 },
             filter: r.choice(&FILTER),
             edge: r.choice(&EDGE),
-            view: r.pick(&VIEW, views(kind)),
+            view: r.pick(&VIEW, kind.views),
             affects: r.choice(&TRANSITION_AFFECTS),
             spread: r.double(&TRANSITION_SPREAD),
             mix: r.double(&MIX),

@@ -2,7 +2,8 @@
 //! id, label, hint, default and range stated once.
 
 use std::collections::HashMap;
-use std::sync::OnceLock;
+use std::ffi::CStr;
+use std::sync::{Mutex, OnceLock};
 
 use morphfx::choice::Choice;
 use morphfx::image::{EdgeMode, Filter};
@@ -14,14 +15,12 @@ use morphfx::warp::mesh::Pass;
 use morphfx::warp::mffd::MffdSettings;
 use morphfx::warp::thin_plate::ThinPlateSettings;
 
-use crate::nodes::NodeKind;
+use crate::nodes::kind::NodeKind;
+use crate::sync::Locked;
 use crate::wrapper::plugin::Context;
 use crate::wrapper::spec::{Kind, ParamSpec, TextMode};
 
-use super::choices::{
-    methods, pattern_label, view_label, views, Affects, DrawTool, EditSides, EvaluationMode, Show,
-    PATTERNS,
-};
+use super::choices::{pattern_label, Affects, DrawTool, EditSides, EvaluationMode, Show, PATTERNS};
 use super::ids::*;
 
 /// A choice param's kind: `options` labelled by `label`, `default` first
@@ -42,22 +41,37 @@ pub(super) fn choice<C: Choice>(default: C) -> Kind {
     choice_of(C::ALL, C::name, default)
 }
 
-/// The node's params, built once per kind.
-pub fn table(kind: NodeKind) -> &'static [ParamSpec] {
-    static MORPH: OnceLock<Vec<ParamSpec>> = OnceLock::new();
-    static WARP: OnceLock<Vec<ParamSpec>> = OnceLock::new();
-    match kind {
-        NodeKind::Morph => MORPH.get_or_init(|| build_table(kind)),
-        NodeKind::Warp => WARP.get_or_init(|| build_table(kind)),
-    }
+/// A node kind's params and their index by id, built once per kind.
+struct Catalogue {
+    table: Vec<ParamSpec>,
+    index: HashMap<String, usize>,
 }
 
-pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
+/// `kind`'s catalogue, built the first time it is asked for and kept for
+/// the life of the process (a few hundred rows per node type).
+fn catalogue(kind: &'static NodeKind) -> &'static Catalogue {
+    type Catalogues = Mutex<HashMap<&'static CStr, &'static Catalogue>>;
+    static BUILT: OnceLock<Catalogues> = OnceLock::new();
+    let mut built = BUILT.get_or_init(Default::default).locked();
+    built.entry(kind.id).or_insert_with(|| {
+        let table = build_table(kind);
+        let index = table.iter().enumerate().map(|(i, p)| (p.id.clone(), i));
+        let index = index.collect();
+        Box::leak(Box::new(Catalogue { table, index }))
+    })
+}
+
+/// The node's params.
+pub fn table(kind: &'static NodeKind) -> &'static [ParamSpec] {
+    &catalogue(kind).table
+}
+
+pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
     let d = FieldSettings::default();
     let c = Coefficients::default();
     let tp = ThinPlateSettings::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", choice_of(methods(kind), Method::name, Method::Field)),
+        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", choice_of(kind.methods, Method::name, Method::Field)),
         ParamSpec::new(
             PROGRESS,
             "Progress",
@@ -106,8 +120,7 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         ParamSpec::new(KEY_SHAPES, "Key Shapes Here", "Keys Scene Text's shapes at the current frame (a static scene becomes keyed); from then on an edit at a frame keys that frame.", Kind::Button).in_group("lines_group"),
         ParamSpec::new(COPY_SCENE, "Copy Scene Into Node", "Copies Scene File's scene into Scene Text and empties Scene File, so its shapes can be edited in the viewer.", Kind::Button).in_group("lines_group"),
     ];
-    if kind == NodeKind::Warp {
-        // The Warp node has no `auto` method (it needs two pictures).
+    if !kind.has_auto() {
         t.retain(|p| p.id != "auto_group" && p.group.as_deref() != Some("auto_group"));
     }
     for k in 1..=LINE_SLOTS {
@@ -142,7 +155,7 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         .in_group("scene_group"),
         ParamSpec::new(
             OFFSET_A,
-            if kind == NodeKind::Morph {
+            if kind.has_b() {
                 "Frame Offset A"
             } else {
                 "Frame Offset"
@@ -156,7 +169,7 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
         )
         .animated(false),
     ]);
-    if kind == NodeKind::Morph {
+    if kind.has_b() {
         t.push(
             ParamSpec::new(
                 OFFSET_B,
@@ -188,7 +201,7 @@ pub(super) fn build_table(kind: NodeKind) -> Vec<ParamSpec> {
             VIEW,
             "View",
             "What the node outputs. ghost: where the warped sources still disagree (alpha the mean |A - B| over R, G, B; colour a heat ramp, black where they agree): double edges to fix. folds: where a warp folds the image over itself (alpha 1 there, the morph tinted magenta beneath).",
-            choice_of(views(kind), |v| view_label(kind, v), views(kind)[0]),
+            choice_of(kind.views, |v| kind.view_label(v), kind.views[0]),
         ),
         ParamSpec::new(
             MASK_INVERT,
@@ -263,22 +276,15 @@ pub(super) fn slot_specs(k: usize) -> Vec<ParamSpec> {
 
 /// The table entry of param `id`, through an index built once per node: a
 /// render reads a few hundred params from a table of several hundred.
-pub fn spec(kind: NodeKind, id: &str) -> Option<&'static ParamSpec> {
-    type Index = HashMap<&'static str, &'static ParamSpec>;
-    static MORPH: OnceLock<Index> = OnceLock::new();
-    static WARP: OnceLock<Index> = OnceLock::new();
-    let build = || table(kind).iter().map(|p| (p.id.as_str(), p)).collect();
-    let index = match kind {
-        NodeKind::Morph => MORPH.get_or_init(build),
-        NodeKind::Warp => WARP.get_or_init(build),
-    };
-    index.get(id).copied()
+pub fn spec(kind: &'static NodeKind, id: &str) -> Option<&'static ParamSpec> {
+    let c = catalogue(kind);
+    c.index.get(id).map(|&i| &c.table[i])
 }
 
 /// The params a node defines in `context`: its table, and in the
 /// transition context the mandated `Transition` param (Parameters Mandated
 /// In A Context: the plugin defines it, the host drives it).
-pub fn table_in_context(kind: NodeKind, context: Context) -> Vec<ParamSpec> {
+pub fn table_in_context(kind: &'static NodeKind, context: Context) -> Vec<ParamSpec> {
     let mut table = table(kind).to_vec();
     if context == Context::Transition {
         table.push(ParamSpec::new(

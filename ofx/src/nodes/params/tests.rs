@@ -6,19 +6,23 @@ use morphfx::warp::field::FieldSettings;
 
 use crate::wrapper::spec::Kind;
 
-use super::choices::*;
 use super::ids::*;
 use super::settings::*;
 use super::table::*;
-use crate::nodes::NodeKind;
+use crate::nodes::kind::NodeKind;
+use crate::nodes::node::Node;
+use crate::nodes::{Morph, Warp};
+
+const MORPH: &NodeKind = Morph::KIND;
+const WARP: &NodeKind = Warp::KIND;
 
 /// Every choice param's options as MorphFX 1.0 shipped them. Hosts save
 /// a choice by its index, so a saved project reads these back by
 /// position: they may be followed by new options, never reordered,
 /// renamed or removed.
-const RELEASED: &[(NodeKind, &str, &[&str])] = &[
+const RELEASED: &[(&NodeKind, &str, &[&str])] = &[
     (
-        NodeKind::Morph,
+        MORPH,
         "method",
         &[
             "field",
@@ -31,12 +35,12 @@ const RELEASED: &[(NodeKind, &str, &[&str])] = &[
         ],
     ),
     (
-        NodeKind::Warp,
+        WARP,
         "method",
         &["field", "mesh", "triangles", "thin-plate", "mffd", "hybrid"],
     ),
     (
-        NodeKind::Morph,
+        MORPH,
         "view",
         &[
             "morph",
@@ -48,7 +52,7 @@ const RELEASED: &[(NodeKind, &str, &[&str])] = &[
             "grid",
         ],
     ),
-    (NodeKind::Warp, "view", &["warped", "stmap", "grid"]),
+    (WARP, "view", &["warped", "stmap", "grid"]),
 ];
 
 /// Choice params both nodes share, with their released options.
@@ -74,15 +78,15 @@ const RELEASED_BOTH: &[(&str, &[&str])] = &[
     ("draw_tool", &["line", "point", "polyline", "curve"]),
 ];
 
-fn released() -> Vec<(NodeKind, &'static str, &'static [&'static str])> {
+fn released() -> Vec<(&'static NodeKind, &'static str, &'static [&'static str])> {
     let mut all = RELEASED.to_vec();
-    for kind in [NodeKind::Morph, NodeKind::Warp] {
+    for kind in [MORPH, WARP] {
         all.extend(RELEASED_BOTH.iter().map(|(id, o)| (kind, *id, *o)));
     }
     all
 }
 
-fn options(kind: NodeKind, id: &str) -> Option<(Vec<&'static str>, usize)> {
+fn options(kind: &'static NodeKind, id: &str) -> Option<(Vec<&'static str>, usize)> {
     table(kind)
         .iter()
         .find(|p| p.id == id)
@@ -95,10 +99,11 @@ fn options(kind: NodeKind, id: &str) -> Option<(Vec<&'static str>, usize)> {
 #[test]
 fn choice_options_only_ever_grow_at_the_end() {
     for (kind, id, was) in released() {
-        let (now, _) = options(kind, id).unwrap_or_else(|| panic!("{kind:?} lost {id}"));
+        let (now, _) = options(kind, id).unwrap_or_else(|| panic!("{} lost {id}", kind.label));
         assert!(
             now.starts_with(was),
-            "{kind:?} {id}: released {was:?}, now {now:?}"
+            "{} {id}: released {was:?}, now {now:?}",
+            kind.label
         );
     }
 }
@@ -106,15 +111,16 @@ fn choice_options_only_ever_grow_at_the_end() {
 #[test]
 fn every_choice_param_is_recorded_with_a_default_among_its_options() {
     let recorded = released();
-    for kind in [NodeKind::Morph, NodeKind::Warp] {
+    for kind in [MORPH, WARP] {
         for p in table(kind) {
             if let Kind::Choice { options, default } = &p.kind {
                 assert!(
                     recorded.iter().any(|(k, id, _)| *k == kind && *id == p.id),
-                    "{kind:?} {}: record its options in RELEASED",
+                    "{} {}: record its options in RELEASED",
+                    kind.label,
                     p.id
                 );
-                assert!(*default < options.len(), "{kind:?} {}", p.id);
+                assert!(*default < options.len(), "{} {}", kind.label, p.id);
             }
         }
     }
@@ -124,16 +130,16 @@ fn every_choice_param_is_recorded_with_a_default_among_its_options() {
 /// defined, so index k reads back the option labelled k.
 #[test]
 fn choices_read_back_the_option_they_label() {
-    for kind in [NodeKind::Morph, NodeKind::Warp] {
+    for kind in [MORPH, WARP] {
         let (labels, _) = options(kind, METHOD.name()).expect("method");
-        let names: Vec<_> = methods(kind).iter().map(|m| m.name()).collect();
+        let names: Vec<_> = kind.methods.iter().map(|m| m.name()).collect();
         assert_eq!(labels, names);
         let (labels, _) = options(kind, VIEW.name()).expect("view");
-        let names: Vec<_> = views(kind).iter().map(|v| view_label(kind, *v)).collect();
+        let names: Vec<_> = kind.views.iter().map(|v| kind.view_label(*v)).collect();
         assert_eq!(labels, names);
     }
     assert_eq!(
-        options(NodeKind::Morph, EDGE.name()).expect("edge").0,
+        options(MORPH, EDGE.name()).expect("edge").0,
         EdgeMode::names()
     );
 }
@@ -141,19 +147,19 @@ fn choices_read_back_the_option_they_label() {
 /// The defaults a fresh node renders with: what the table declares.
 #[test]
 fn defaults_are_the_tables() {
-    let s = Settings::defaults(NodeKind::Morph);
+    let s = Settings::defaults(MORPH);
     assert_eq!(s.warp.method, Method::Field);
     assert_eq!(s.progress, 0.5);
     assert_eq!(s.view, View::Morph);
     assert_eq!(s.edge, EdgeMode::Clamp);
     assert!(s.lines.is_empty() && s.missing.is_empty());
     assert_eq!(s.warp.field, FieldSettings::default());
-    assert_eq!(Settings::defaults(NodeKind::Warp).view, View::WarpedA);
+    assert_eq!(Settings::defaults(WARP).view, View::WarpedA);
 }
 
 #[test]
 fn ids_are_unique_and_hints_speak_to_compositors() {
-    for kind in [NodeKind::Morph, NodeKind::Warp] {
+    for kind in [MORPH, WARP] {
         let t = table(kind);
         for (i, p) in t.iter().enumerate() {
             assert!(t[i + 1..].iter().all(|q| q.id != p.id), "{} twice", p.id);

@@ -8,7 +8,7 @@ use morphfx::geom::PixelScale;
 use morphfx::image::Sample;
 use morphfx::transition::{Matte, Transition, TransitionSettings};
 
-use super::scale_of;
+use crate::nodes::kind::TIMING_CLIP;
 use crate::nodes::params::{pacing, Settings};
 use crate::wrapper::clips::{Depth, HostImage};
 use crate::wrapper::{Failure, Outcome};
@@ -16,7 +16,7 @@ use crate::wrapper::{Failure, Outcome};
 /// The timing matte of `image`: its alpha (an RGB matte's mean) per pixel.
 pub(super) fn timing_matte(image: &HostImage) -> Outcome<Matte> {
     let info = image.info();
-    let scale: PixelScale = scale_of(info);
+    let scale: PixelScale = info.pixel_scale();
     let alpha = with_depth!(info.depth, S => {
         let view = image.view::<S>()?;
         let b = view.bounds();
@@ -34,7 +34,7 @@ pub(super) fn timing_matte(image: &HostImage) -> Outcome<Matte> {
         alpha
     });
     Matte::new(info.bounds, scale, alpha)
-        .map_err(|e| Failure::BadInput(format!("clip {}: {e}", super::super::TIMING_CLIP)))
+        .map_err(|e| Failure::BadInput(format!("clip {}: {e}", TIMING_CLIP)))
 }
 
 /// The transitions with the timing matte in place of the node's pattern

@@ -5,7 +5,6 @@
 //! aspect happen here, once: the core sees canonical coordinates only.
 
 mod draw;
-mod inputs;
 mod regions;
 mod warm;
 
@@ -23,16 +22,15 @@ use morphfx::warp::auto::WorkImage;
 use morphfx::warp::mesh::Pass;
 use morphfx::warp::Warp;
 
-use super::params::Settings;
-use super::state::NodeState;
-use super::{NodeKind, MASK_CLIP, TIMING_CLIP};
 use crate::cache::Key;
-use crate::wrapper::clips::{Depth, EffectHandle, HostImage, HostSample, ImageInfo};
+use crate::nodes::inputs::{warp_inputs, WarpInputs};
+use crate::nodes::kind::{NodeKind, MASK_CLIP, TIMING_CLIP};
+use crate::nodes::params::Settings;
+use crate::nodes::state::NodeState;
+use crate::wrapper::clips::{Depth, EffectHandle, HostImage, HostSample};
 use crate::wrapper::plugin::RenderArgs;
 use crate::wrapper::{Failure, Outcome};
 use draw::Job;
-use inputs::WarpInputs;
-pub(super) use inputs::{load_scene, warp_inputs};
 pub use regions::{
     clip_preferences, frames_needed, is_identity, region_of_definition, regions_of_interest,
 };
@@ -125,10 +123,6 @@ fn source(effect: &EffectHandle, name: &str, time: f64) -> Outcome<Option<HostIm
     clip.image(time)
 }
 
-pub(super) fn scale_of(i: &ImageInfo) -> PixelScale {
-    PixelScale::new(i.render_scale.0, i.render_scale.1, i.par)
-}
-
 /// The most pixels one render window may have.
 const MAX_RENDER_PIXELS: usize = 1 << 28;
 
@@ -160,7 +154,7 @@ fn gather(
         Some(b) => source(effect, b, time + settings.offset_b as f64)?,
         None => None,
     };
-    if kind == NodeKind::Morph {
+    if kind.has_b() {
         if let Some(image) = source(effect, TIMING_CLIP, time)? {
             let matte = mattes::timing_matte(&image)?;
             inputs.warp.settings.transition = mattes::timed(matte, &settings);
@@ -177,18 +171,18 @@ fn gather(
         .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
     // The spec: non-optional clips are always connected during a render.
     let rod = regions::output_region(instance, effect, time)?.ok_or_else(|| {
-        Failure::BadInput(format!("no source clip of {} is connected", kind.label()))
+        Failure::BadInput(format!("no source clip of {} is connected", kind.label))
     })?;
     // Triangles pin the border of the frame, so the whole frame warps.
     inputs.warp.region = Some(regions::warp_region(effect, &rod));
-    let out_scale = scale_of(out.info());
+    let out_scale = out.info().pixel_scale();
     let depth = source_depth(&a, &b, out.info().depth)?;
     let sources = [&a, &b].map(|s| {
         s.as_ref().map(|image| {
             let i = image.info();
             Source {
-                scale: scale_of(i),
-                covers: canonical(i.bounds, scale_of(i)),
+                scale: i.pixel_scale(),
+                covers: canonical(i.bounds, i.pixel_scale()),
                 premultiplied: i.premultiplied,
             }
         })
@@ -220,7 +214,7 @@ fn gather(
 
 /// The params at `time`; params the host could not read are said once.
 fn read_settings(
-    kind: NodeKind,
+    kind: &'static NodeKind,
     effect: &EffectHandle,
     instance: &NodeState,
     time: f64,
@@ -308,7 +302,11 @@ fn correspond(instance: &NodeState, request: &mut Request) -> Outcome {
 /// what [`gather`] read: the maps for the render window, the dissolve
 /// weights, the transition rates. Pure given the instance's caches: no
 /// host call.
-fn prepare<'r>(kind: NodeKind, instance: &'r NodeState, request: &'r Request) -> Outcome<Job<'r>> {
+fn prepare<'r>(
+    kind: &'static NodeKind,
+    instance: &'r NodeState,
+    request: &'r Request,
+) -> Outcome<Job<'r>> {
     let inputs = &request.inputs;
     let view = request.settings.view;
     // The two-pass mesh warp makes pixels (per render window), not a map:
@@ -321,7 +319,7 @@ fn prepare<'r>(kind: NodeKind, instance: &'r NodeState, request: &'r Request) ->
     let picture = view.is_picture();
     // A non-uniform colour transition weighs every pixel of the dissolve.
     let weighted = matches!(view, View::Morph | View::Folds)
-        && kind == NodeKind::Morph
+        && kind.has_b()
         && !inputs
             .warp
             .settings
@@ -477,8 +475,8 @@ fn needs_a(view: View) -> bool {
     )
 }
 
-fn needs_b(kind: NodeKind, view: View) -> bool {
-    kind == NodeKind::Morph
+fn needs_b(kind: &NodeKind, view: View) -> bool {
+    kind.has_b()
         && matches!(
             view,
             View::Morph | View::WarpedB | View::StmapB | View::Ghost | View::Folds
@@ -500,7 +498,7 @@ fn view_of<'a, S: HostSample>(
 
 /// Writes the render window of the output: samplers over the lent sources
 /// at their depth, rows of the output at its own.
-fn draw(kind: NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Outcome {
+fn draw(kind: &NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Outcome {
     let settings = &request.settings;
     let [a, b] = &lent.sources;
     let sampler_parts = |k: usize, s: &Option<HostImage>| {
@@ -527,7 +525,7 @@ fn draw(kind: NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Ou
             let src = view_of::<S>(a, &black)?;
             let a = Sampler::new(src, a_scale, settings.filter, a_edge, a_pre);
             let b = Sampler::new(view_of::<S>(b, &black)?, b_scale, settings.filter, b_edge, b_pre);
-            let b = (kind == NodeKind::Morph).then_some(&b);
+            let b = kind.has_b().then_some(&b);
             if !mixed {
                 job.draw(&a, b, rows);
                 return Ok(());
@@ -558,7 +556,7 @@ type MaskPlane<'a> = Box<dyn Fn(RectI, PixelScale) -> Image + 'a>;
 /// The lent mask as a maker of its alpha plane at its own depth: sampled at
 /// the output's pixel centres, transparent outside its region.
 fn mask_of(image: &HostImage) -> Outcome<MaskPlane<'_>> {
-    let scale = scale_of(image.info());
+    let scale = image.info().pixel_scale();
     Ok(with_depth!(image.info().depth, M => {
         let view = image.view::<M>()?;
         Box::new(move |window: RectI, out_scale: PixelScale| {
@@ -571,6 +569,8 @@ fn mask_of(image: &HostImage) -> Outcome<MaskPlane<'_>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nodes::node::Node;
+    use crate::nodes::{Morph, Warp};
     use crate::wrapper::params::Params;
     use crate::wrapper::plugin::Context;
     use morphfx::features::Feature;
@@ -586,7 +586,7 @@ mod tests {
 
     /// A render of a 64x48 frame's window (8, 8)-(24, 20), made by hand.
     fn request(t: f64, view: View) -> Request {
-        let mut settings = Settings::defaults(NodeKind::Morph);
+        let mut settings = Settings::defaults(<Morph as Node>::KIND);
         settings.view = view;
         let features = vec![Feature::line(
             [Vec2::new(10.0, 10.0), Vec2::new(50.0, 12.0)],
@@ -616,9 +616,10 @@ mod tests {
     /// them in the cache.
     #[test]
     fn prepare_makes_the_cores_maps_for_the_window_once() {
-        let instance = NodeState::create(NodeKind::Morph, Context::General, Params::unbound());
+        let instance =
+            NodeState::create(<Morph as Node>::KIND, Context::General, Params::unbound());
         let r = request(0.25, View::Morph);
-        let job = prepare(NodeKind::Morph, &instance, &r).expect("prepared");
+        let job = prepare(<Morph as Node>::KIND, &instance, &r).expect("prepared");
         for (side, got) in [(Side::A, &job.map_a), (Side::B, &job.map_b)] {
             let got = got.as_ref().expect("a map per side");
             let want = make_warp::toward(&r.inputs.features, side, 0.25, &r.inputs.warp)
@@ -626,25 +627,26 @@ mod tests {
                 .map_window(r.window, PixelScale::UNIT);
             assert_eq!(**got, want, "{side:?}");
         }
-        let again = prepare(NodeKind::Morph, &instance, &r).expect("prepared");
+        let again = prepare(<Morph as Node>::KIND, &instance, &r).expect("prepared");
         assert!(Arc::ptr_eq(
             job.map_a.as_ref().unwrap(),
             again.map_a.as_ref().unwrap()
         ));
         let later = request(0.75, View::Morph);
-        let moved = prepare(NodeKind::Morph, &instance, &later).expect("prepared");
+        let moved = prepare(<Morph as Node>::KIND, &instance, &later).expect("prepared");
         assert_ne!(job.map_a, moved.map_a, "another progress, another map");
     }
 
     /// Views take only the maps they draw: the Warp node never makes B's.
     #[test]
     fn prepare_makes_only_the_maps_a_view_draws() {
-        let instance = NodeState::create(NodeKind::Morph, Context::General, Params::unbound());
+        let instance =
+            NodeState::create(<Morph as Node>::KIND, Context::General, Params::unbound());
         let r = request(0.5, View::StmapB);
-        let stmap_b = prepare(NodeKind::Morph, &instance, &r).unwrap();
+        let stmap_b = prepare(<Morph as Node>::KIND, &instance, &r).unwrap();
         assert!(stmap_b.map_a.is_none() && stmap_b.map_b.is_some());
         let r = request(0.5, View::WarpedA);
-        let warp = prepare(NodeKind::Warp, &instance, &r).unwrap();
+        let warp = prepare(<Warp as Node>::KIND, &instance, &r).unwrap();
         assert!(warp.map_a.is_some() && warp.map_b.is_none());
     }
 

@@ -5,9 +5,10 @@ use morphfx::features::Side;
 use morphfx::geom::{RectD, Vec2};
 use morphfx::views::View;
 
-use super::inputs::{warp_inputs, WarpInputs};
-use crate::nodes::params::{views, Reader, Settings, OFFSET_A, OFFSET_B, VIEW};
-use crate::nodes::{NodeKind, NodeState, MASK_CLIP, TIMING_CLIP};
+use crate::nodes::inputs::{warp_inputs, WarpInputs};
+use crate::nodes::kind::{NodeKind, MASK_CLIP, TIMING_CLIP};
+use crate::nodes::params::{Reader, Settings, OFFSET_A, OFFSET_B, VIEW};
+use crate::nodes::state::NodeState;
 use crate::wrapper::clips::EffectHandle;
 use crate::wrapper::plugin::{ClipPreferences, FramesNeeded, Identity, RenderArgs, Rois};
 use crate::wrapper::{Outcome, Reply};
@@ -24,7 +25,7 @@ fn source_times(node: &NodeState, time: f64) -> impl Iterator<Item = (&'static s
 fn offsets(node: &NodeState, time: f64) -> (f64, f64) {
     let r = Reader::new(node.params(), node.kind, time);
     let a = r.int(&OFFSET_A) as f64;
-    let b = if node.kind == NodeKind::Morph {
+    let b = if node.kind.has_b() {
         r.int(&OFFSET_B) as f64
     } else {
         0.0
@@ -100,7 +101,7 @@ pub fn clip_preferences(
     out.set_premultiplied_output(straight.is_empty() || !straight.iter().all(|s| *s));
     // The ghost and folds views put their measure in alpha: an RGB output
     // (what hosts give RGB sources) would drop it.
-    let view = Reader::new(node.params(), node.kind, 0.0).pick(&VIEW, views(node.kind));
+    let view = Reader::new(node.params(), node.kind, 0.0).pick(&VIEW, node.kind.views);
     if matches!(view, View::Ghost | View::Folds) {
         out.set_rgba_output();
     }
@@ -130,7 +131,7 @@ pub fn regions_of_interest(
 /// The mattes (Mask; Timing on the Morph node), read at the output's time:
 /// the timing matte anywhere on A, so both whole.
 fn matte_times(node: &NodeState, time: f64) -> impl Iterator<Item = (&'static str, f64)> {
-    let timing = (node.kind == NodeKind::Morph).then_some((TIMING_CLIP, time));
+    let timing = node.kind.timing_matte.then_some((TIMING_CLIP, time));
     timing.into_iter().chain([(MASK_CLIP, time)])
 }
 
@@ -184,7 +185,7 @@ pub fn is_identity(
 }
 
 /// Which source the output is at `inputs`' progress, when it is one unchanged.
-fn identity_side(kind: NodeKind, view: View, inputs: &WarpInputs) -> Option<Side> {
+fn identity_side(kind: &NodeKind, view: View, inputs: &WarpInputs) -> Option<Side> {
     let transition = &inputs.warp.settings.transition;
     if !(transition.geometry.is_uniform_at(inputs.t) && transition.colour().is_uniform_at(inputs.t))
     {
@@ -192,7 +193,7 @@ fn identity_side(kind: NodeKind, view: View, inputs: &WarpInputs) -> Option<Side
     }
     let side = if inputs.t <= 0.0 {
         Side::A
-    } else if inputs.t >= 1.0 && kind == NodeKind::Morph {
+    } else if inputs.t >= 1.0 && kind.has_b() {
         Side::B
     } else {
         return None;

@@ -13,8 +13,8 @@ use morphfx::warp::auto::{self, Correspondence, WorkImage};
 use morphfx::warp::thin_plate::multigrid::Report;
 use morphfx::warp::thin_plate::ThinPlateWarp;
 
-use super::inputs::WarpInputs;
 use crate::cache::Key;
+use crate::nodes::inputs::WarpInputs;
 use crate::nodes::state::{NodeState, GRIDS_KEPT, PLATES_KEPT};
 use crate::sync::Locked;
 use crate::wrapper::{Failure, Outcome};

@@ -1,0 +1,209 @@
+//! A node type as the OpenFX layer sees it: every [`Node`] is an
+//! [`ImageEffect`] (its clips and params from its [`NodeKind`], its actions
+//! handed to `render`, the buttons and the overlay), so a node's own file
+//! states what it is and nothing more.
+
+use std::ffi::CStr;
+
+use morphfx::geom::RectD;
+
+use super::kind::{NodeKind, MASK_CLIP, OUTPUT_CLIP, TIMING_CLIP, VERSION};
+use super::state::NodeState;
+use super::{lines, overlay, params, render, snap, track};
+use crate::wrapper::clips::EffectHandle;
+use crate::wrapper::paint::Painter;
+use crate::wrapper::params::Params;
+use crate::wrapper::plugin::{
+    Capabilities, ClipPreferences, ClipSpec, Components, Context, ContextSpec, DrawArgs,
+    FramesNeeded, Identity, ImageEffect, Overlay, OverlayActions, ParamChange, Pen, PixelDepth,
+    RenderArgs, Rois, Sequential, ThreadSafety,
+};
+use crate::wrapper::{Outcome, Reply};
+
+/// A MorphFX node type: what it is, and its state.
+pub trait Node: Sized + Send + Sync + 'static {
+    const KIND: &'static NodeKind;
+    fn new(state: NodeState) -> Self;
+    fn state(&self) -> &NodeState;
+}
+
+/// The pixel layouts every clip takes.
+const COMPONENTS: &[Components] = &[Components::Rgba, Components::Rgb, Components::Alpha];
+
+/// The layouts the mask and timing clips take: their alpha is what counts,
+/// and a matte with no alpha (a grey or RGB render) counts by the mean of
+/// its R, G and B, so a host hands it over as RGB rather than with an
+/// alpha of 1 filled in.
+const MATTE_COMPONENTS: &[Components] = &[Components::Alpha, Components::Rgba, Components::Rgb];
+
+impl<N: Node> ImageEffect for N {
+    const ID: &'static CStr = N::KIND.id;
+    const VERSION: (u32, u32) = VERSION;
+    const LABEL: &'static str = N::KIND.label;
+    const DESCRIPTION: &'static str = N::KIND.description;
+    const GROUPING: &'static str = "MorphFX";
+    const CONTEXTS: &'static [Context] = N::KIND.contexts;
+    const CAPABILITIES: Capabilities = Capabilities {
+        depths: &[PixelDepth::Byte, PixelDepth::Short, PixelDepth::Float],
+        thread_safety: ThreadSafety::FullySafe,
+        // We split the window across threads ourselves (rayon).
+        host_frame_threading: false,
+        tiles: true,
+        multi_resolution: true,
+        temporal_access: true,
+        multiple_clip_depths: false,
+        multiple_clip_aspects: false,
+        // Warm starts make a sequence cheaper in frame order, but any order
+        // is correct (they are used only when the host says it renders in
+        // order). FieldRenderTwiceAlways keeps its default (render each
+        // field): a geometric warp must not mix the fields of interlaced
+        // footage.
+        sequential: Sequential::Preferred,
+    };
+    const OVERLAY: Option<OverlayActions<Self>> = Some(OverlayActions::of::<FeatureOverlay>());
+
+    fn describe_in_context(context: Context) -> ContextSpec {
+        let (a, b) = N::KIND.source_clips(context);
+        let source = |name| ClipSpec {
+            name,
+            components: COMPONENTS,
+            tiles: true,
+            temporal_access: true,
+            optional: false,
+            mask: false,
+        };
+        let mut clips: Vec<ClipSpec> = std::iter::once(a).chain(b).map(source).collect();
+        // Mattes: alpha is what is read (an RGB matte's mean); the timing
+        // matte may be read anywhere on A.
+        let matte = |name, mask| ClipSpec {
+            name,
+            components: MATTE_COMPONENTS,
+            tiles: true,
+            temporal_access: false,
+            optional: true,
+            mask,
+        };
+        if N::KIND.timing_matte {
+            clips.push(matte(TIMING_CLIP, false));
+        }
+        clips.push(matte(MASK_CLIP, true));
+        clips.push(ClipSpec {
+            temporal_access: false,
+            ..source(OUTPUT_CLIP)
+        });
+        ContextSpec {
+            clips,
+            params: params::table_in_context(N::KIND, context),
+        }
+    }
+
+    fn create(_: &EffectHandle, context: Context, params: Params) -> Outcome<Self> {
+        lines::hide_unused(N::KIND, &params, 0.0);
+        Ok(N::new(NodeState::create(N::KIND, context, params)))
+    }
+
+    fn purge(&self) {
+        self.state().purge();
+    }
+
+    fn region_of_definition(&self, effect: &EffectHandle, time: f64) -> Outcome<Option<RectD>> {
+        render::region_of_definition(self.state(), effect, time)
+    }
+
+    fn regions_of_interest(
+        &self,
+        effect: &EffectHandle,
+        time: f64,
+        out: &mut Rois,
+    ) -> Outcome<Reply> {
+        render::regions_of_interest(self.state(), effect, time, out)
+    }
+
+    fn frames_needed(
+        &self,
+        effect: &EffectHandle,
+        time: f64,
+        out: &mut FramesNeeded,
+    ) -> Outcome<Reply> {
+        render::frames_needed(self.state(), effect, time, out)
+    }
+
+    fn clip_preferences(&self, effect: &EffectHandle, out: &mut ClipPreferences) -> Outcome<Reply> {
+        render::clip_preferences(self.state(), effect, out)
+    }
+
+    fn is_identity(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome<Option<Identity>> {
+        render::is_identity(self.state(), effect, args)
+    }
+
+    fn render(&self, effect: &EffectHandle, args: &RenderArgs) -> Outcome {
+        render::render(self.state(), effect, args)
+    }
+
+    fn param_changed(&self, effect: &EffectHandle, change: &ParamChange) -> Outcome {
+        param_changed(self.state(), effect, change)
+    }
+}
+
+/// A param changed: the buttons act, Line Count shows its slots.
+fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) -> Outcome {
+    let (name, time) = (change.name.as_str(), change.time);
+    if name == params::SNAP_LINES.name() {
+        snap::snap_lines(node, effect, time)
+    } else if name == params::TRACK_FORWARD.name() {
+        track::track_lines(node, effect, time, 1)
+    } else if name == params::TRACK_BACKWARD.name() {
+        track::track_lines(node, effect, time, -1)
+    } else if name == params::FINISH_SHAPE.name() {
+        overlay::finish_shape(node);
+        Ok(())
+    } else if name == params::DELETE_SHAPE.name() {
+        overlay::delete_shape(node, effect, time)
+    } else if name == params::KEY_SHAPES.name() {
+        overlay::shapes::key_here(node, effect, time)
+    } else if name == params::COPY_SCENE.name() {
+        overlay::shapes::copy_scene(node, effect, time)
+    } else if name == params::LINE_COUNT.name() {
+        lines::hide_unused(node.kind, node.params(), time);
+        Ok(())
+    } else if let Some(k) = params::clear_button_slot(name) {
+        lines::clear(node.kind, node.params(), k, time)
+    } else {
+        Ok(())
+    }
+}
+
+/// The overlay every node shares: its features drawn and edited.
+pub struct FeatureOverlay;
+
+impl<N: Node> Overlay<N> for FeatureOverlay {
+    fn slave_params() -> Vec<String> {
+        overlay::slave_params()
+    }
+    fn draw(node: &N, _: &EffectHandle, args: &DrawArgs, p: &mut dyn Painter) -> Outcome<Reply> {
+        overlay::draw(node.state(), args, p)
+    }
+    fn pen_down(node: &N, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+        overlay::pen_down(node.state(), effect, pen)
+    }
+    fn pen_motion(
+        node: &N,
+        effect: &EffectHandle,
+        pen: Pen,
+        redraw: &mut dyn FnMut(),
+    ) -> Outcome<Reply> {
+        overlay::pen_motion(node.state(), effect, pen, redraw)
+    }
+    fn pen_up(node: &N, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+        overlay::pen_up(node.state(), effect, pen)
+    }
+    fn key_down(node: &N, effect: &EffectHandle, key: i32, time: f64) -> Outcome<Reply> {
+        overlay::key_down(node.state(), effect, key, time)
+    }
+    fn key_up(node: &N, _: &EffectHandle, key: i32) -> Outcome<Reply> {
+        overlay::key_up(node.state(), key)
+    }
+    fn lose_focus(node: &N, _: &EffectHandle) -> Outcome<Reply> {
+        overlay::lose_focus(node.state())
+    }
+}
