@@ -9,8 +9,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The crates checked, by the folder of their root file.
-const CRATES: [(&str, &str); 5] = [
+const CRATES: [(&str, &str); 6] = [
     (".", "src/lib.rs"),
+    ("ofx-layer", "src/lib.rs"),
     ("ofx", "src/lib.rs"),
     ("harness", "src/lib.rs"),
     ("harness", "src/main.rs"),

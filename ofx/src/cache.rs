@@ -16,7 +16,7 @@ use std::sync::{Arc, Mutex, OnceLock, Weak};
 use morphfx::image::WarpMap;
 use morphfx::warp::auto::Correspondence;
 
-use crate::sync::Locked;
+use ofx_layer::sync::Locked;
 
 /// Default process-wide budget, MiB (a 1080p map is 16 MiB).
 pub const DEFAULT_BUDGET_MB: usize = 256;

@@ -9,9 +9,9 @@ use morphfx::scene::Scene;
 
 use crate::nodes::params::{Settings, TRANSITION_PARAM};
 use crate::nodes::state::NodeState;
-use crate::sync::Locked;
-use crate::wrapper::plugin::Context;
-use crate::wrapper::{Failure, Outcome};
+use ofx_layer::plugin::Context;
+use ofx_layer::sync::Locked;
+use ofx_layer::{Failure, Outcome};
 
 /// The scene named by the params, parsed once per content.
 pub(in crate::nodes) fn load_scene(

@@ -10,7 +10,7 @@ use std::ffi::CStr;
 use morphfx::make_warp::Method;
 use morphfx::views::View;
 
-use crate::wrapper::plugin::Context;
+use ofx_layer::plugin::Context;
 
 /// What a node type is: its identity for hosts, its inputs, and what it
 /// offers. Every field is stated by the node's own file.

@@ -8,9 +8,9 @@ use super::kind::NodeKind;
 use super::params::{
     slot_clear, slot_group, slot_ids, spec, Id, Point, Reader, SlotIds, LINE_COUNT, LINE_SLOTS,
 };
-use crate::wrapper::params::Params;
-use crate::wrapper::spec::Kind;
-use crate::wrapper::Outcome;
+use ofx_layer::params::Params;
+use ofx_layer::spec::Kind;
+use ofx_layer::Outcome;
 
 /// One enabled slot's lines at a time: A's and B's, start then end.
 #[derive(Debug, Clone, Copy, PartialEq)]

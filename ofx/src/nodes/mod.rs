@@ -20,4 +20,5 @@ mod track;
 mod warp;
 
 pub use morph::Morph;
+pub use node::Effect;
 pub use warp::Warp;

@@ -8,10 +8,9 @@ use morphfx::views::View;
 
 use super::kind::{NodeKind, Sources};
 use super::node::Node;
-use super::state::NodeState;
-use crate::wrapper::plugin::Context;
+use ofx_layer::plugin::Context;
 
-pub struct Morph(NodeState);
+pub struct Morph;
 
 impl Node for Morph {
     const KIND: &'static NodeKind = &NodeKind {
@@ -28,10 +27,4 @@ impl Node for Morph {
         views: View::ALL,
         view_labels: &[],
     };
-    fn new(state: NodeState) -> Self {
-        Morph(state)
-    }
-    fn state(&self) -> &NodeState {
-        &self.0
-    }
 }

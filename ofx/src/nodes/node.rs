@@ -4,27 +4,39 @@
 //! states what it is and nothing more.
 
 use std::ffi::CStr;
+use std::marker::PhantomData;
 
 use morphfx::geom::RectD;
 
 use super::kind::{NodeKind, MASK_CLIP, OUTPUT_CLIP, TIMING_CLIP, VERSION};
 use super::state::NodeState;
 use super::{lines, overlay, params, render, snap, track};
-use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::paint::Painter;
-use crate::wrapper::params::Params;
-use crate::wrapper::plugin::{
+use ofx_layer::clips::EffectHandle;
+use ofx_layer::paint::Painter;
+use ofx_layer::params::Params;
+use ofx_layer::plugin::{
     Capabilities, ClipPreferences, ClipSpec, Components, Context, ContextSpec, DrawArgs,
     FramesNeeded, Identity, ImageEffect, Overlay, OverlayActions, ParamChange, Pen, PixelDepth,
     RenderArgs, Rois, Sequential, ThreadSafety,
 };
-use crate::wrapper::{Outcome, Reply};
+use ofx_layer::{Outcome, Reply};
 
-/// A MorphFX node type: what it is, and its state.
-pub trait Node: Sized + Send + Sync + 'static {
+/// A MorphFX node type: a marker type stating what it is.
+pub trait Node: Send + Sync + 'static {
     const KIND: &'static NodeKind;
-    fn new(state: NodeState) -> Self;
-    fn state(&self) -> &NodeState;
+}
+
+/// An instance of node type `N`: what the OpenFX layer creates, holds and
+/// hands each action to.
+pub struct Effect<N> {
+    state: NodeState,
+    node: PhantomData<fn() -> N>,
+}
+
+impl<N> Effect<N> {
+    fn state(&self) -> &NodeState {
+        &self.state
+    }
 }
 
 /// The pixel layouts every clip takes.
@@ -36,7 +48,7 @@ const COMPONENTS: &[Components] = &[Components::Rgba, Components::Rgb, Component
 /// alpha of 1 filled in.
 const MATTE_COMPONENTS: &[Components] = &[Components::Alpha, Components::Rgba, Components::Rgb];
 
-impl<N: Node> ImageEffect for N {
+impl<N: Node> ImageEffect for Effect<N> {
     const ID: &'static CStr = N::KIND.id;
     const VERSION: (u32, u32) = VERSION;
     const LABEL: &'static str = N::KIND.label;
@@ -99,7 +111,10 @@ impl<N: Node> ImageEffect for N {
 
     fn create(_: &EffectHandle, context: Context, params: Params) -> Outcome<Self> {
         lines::hide_unused(N::KIND, &params, 0.0);
-        Ok(N::new(NodeState::create(N::KIND, context, params)))
+        Ok(Effect {
+            state: NodeState::create(N::KIND, context, params),
+            node: PhantomData,
+        })
     }
 
     fn purge(&self) {
@@ -176,34 +191,39 @@ fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) 
 /// The overlay every node shares: its features drawn and edited.
 pub struct FeatureOverlay;
 
-impl<N: Node> Overlay<N> for FeatureOverlay {
+impl<N: Node> Overlay<Effect<N>> for FeatureOverlay {
     fn slave_params() -> Vec<String> {
         overlay::slave_params()
     }
-    fn draw(node: &N, _: &EffectHandle, args: &DrawArgs, p: &mut dyn Painter) -> Outcome<Reply> {
+    fn draw(
+        node: &Effect<N>,
+        _: &EffectHandle,
+        args: &DrawArgs,
+        p: &mut dyn Painter,
+    ) -> Outcome<Reply> {
         overlay::draw(node.state(), args, p)
     }
-    fn pen_down(node: &N, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+    fn pen_down(node: &Effect<N>, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
         overlay::pen_down(node.state(), effect, pen)
     }
     fn pen_motion(
-        node: &N,
+        node: &Effect<N>,
         effect: &EffectHandle,
         pen: Pen,
         redraw: &mut dyn FnMut(),
     ) -> Outcome<Reply> {
         overlay::pen_motion(node.state(), effect, pen, redraw)
     }
-    fn pen_up(node: &N, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
+    fn pen_up(node: &Effect<N>, effect: &EffectHandle, pen: Pen) -> Outcome<Reply> {
         overlay::pen_up(node.state(), effect, pen)
     }
-    fn key_down(node: &N, effect: &EffectHandle, key: i32, time: f64) -> Outcome<Reply> {
+    fn key_down(node: &Effect<N>, effect: &EffectHandle, key: i32, time: f64) -> Outcome<Reply> {
         overlay::key_down(node.state(), effect, key, time)
     }
-    fn key_up(node: &N, _: &EffectHandle, key: i32) -> Outcome<Reply> {
+    fn key_up(node: &Effect<N>, _: &EffectHandle, key: i32) -> Outcome<Reply> {
         overlay::key_up(node.state(), key)
     }
-    fn lose_focus(node: &N, _: &EffectHandle) -> Outcome<Reply> {
+    fn lose_focus(node: &Effect<N>, _: &EffectHandle) -> Outcome<Reply> {
         overlay::lose_focus(node.state())
     }
 }

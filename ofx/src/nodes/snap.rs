@@ -12,8 +12,8 @@ use morphfx::snake::{EdgeEnergy, Snake, SnakeSettings};
 use super::overlay::shapes;
 use super::params::{slot_ids, Reader, Settings, SlotIds, LINE_COUNT, SNAP_SIGMA};
 use super::state::NodeState;
-use crate::wrapper::clips::{Depth, EffectHandle};
-use crate::wrapper::{Failure, Outcome};
+use ofx_layer::clips::{Depth, EffectHandle};
+use ofx_layer::{Failure, Outcome};
 
 /// The Snap Lines button, pressed at `time`.
 pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Outcome {

@@ -14,9 +14,9 @@ use morphfx::warp::thin_plate::ThinPlate;
 use super::kind::NodeKind;
 use super::overlay::State as OverlayState;
 use crate::cache::{Cache, Key, WarpCache};
-use crate::sync::Locked;
-use crate::wrapper::params::Params;
-use crate::wrapper::plugin::Context;
+use ofx_layer::params::Params;
+use ofx_layer::plugin::Context;
+use ofx_layer::sync::Locked;
 
 pub struct NodeState {
     pub kind: &'static NodeKind,

@@ -23,10 +23,10 @@ use super::lines::{end_id, slot_lines, SlotLine};
 use super::overlay::shapes;
 use super::params::{Reader, Settings};
 use super::state::NodeState;
-use crate::wrapper::clips::{Depth, EffectHandle};
-use crate::wrapper::params::Params;
-use crate::wrapper::plugin::Context;
-use crate::wrapper::{Failure, Outcome};
+use ofx_layer::clips::{Depth, EffectHandle};
+use ofx_layer::params::Params;
+use ofx_layer::plugin::Context;
+use ofx_layer::{Failure, Outcome};
 
 /// Frames tracked at most when neither keys nor the clip say where to stop.
 const MAX_FRAMES: i64 = 10_000;

@@ -6,10 +6,9 @@ use morphfx::views::View;
 
 use super::kind::{NodeKind, Sources};
 use super::node::Node;
-use super::state::NodeState;
-use crate::wrapper::plugin::Context;
+use ofx_layer::plugin::Context;
 
-pub struct Warp(NodeState);
+pub struct Warp;
 
 impl Node for Warp {
     const KIND: &'static NodeKind = &NodeKind {
@@ -31,10 +30,4 @@ impl Node for Warp {
         views: &[View::WarpedA, View::StmapA, View::Grid, View::Folds],
         view_labels: &[(View::WarpedA, "warped"), (View::StmapA, "stmap")],
     };
-    fn new(state: NodeState) -> Self {
-        Warp(state)
-    }
-    fn state(&self) -> &NodeState {
-        &self.0
-    }
 }

@@ -2,7 +2,7 @@
 //! Scene Text's shapes, Scene File's features dimmer) with directions,
 //! names, connectors and in-between shapes, and edited with the pen: drag
 //! a point or a whole feature, draw lines, points, polylines and curves,
-//! insert and delete points. The wrapper turns interact actions into these
+//! insert and delete points. The OpenFX layer turns interact actions into these
 //! calls; `pen` holds what the pen does, `shapes` the Scene Text edits.
 
 mod hit;
@@ -21,9 +21,9 @@ use crate::nodes::params::{
     slot_ids, DRAW_TOOL, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT, OVERLAY_SHOW, SCENE_FILE, SCENE_TEXT,
 };
 use crate::nodes::state::NodeState;
-use crate::sync::Locked;
-use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::{keys, Outcome, Reply};
+use ofx_layer::clips::EffectHandle;
+use ofx_layer::sync::Locked;
+use ofx_layer::{keys, Outcome, Reply};
 
 /// The params every overlay redraw depends on (the interact is slaved to them).
 pub fn slave_params() -> Vec<String> {

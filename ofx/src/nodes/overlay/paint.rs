@@ -7,7 +7,7 @@ use morphfx::geom::Vec2;
 use super::outline::{per_span, Outline};
 use super::state::{Handle, Owner, Part};
 use crate::nodes::params::Show;
-use crate::wrapper::paint::{Painter, Stipple, LABEL_PX};
+use ofx_layer::paint::{Painter, Stipple, LABEL_PX};
 
 /// Everything one draw shows.
 pub struct Frame<'a> {

@@ -16,11 +16,11 @@ use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
 use crate::nodes::params::{OVERLAY_EDIT, OVERLAY_SHOW};
 use crate::nodes::state::NodeState;
-use crate::sync::Locked;
-use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::params::Params;
-use crate::wrapper::plugin::Pen;
-use crate::wrapper::{keys, Failure, Outcome, Reply};
+use ofx_layer::clips::EffectHandle;
+use ofx_layer::params::Params;
+use ofx_layer::plugin::Pen;
+use ofx_layer::sync::Locked;
+use ofx_layer::{keys, Failure, Outcome, Reply};
 
 /// Shortest new line kept, in screen pixels: a click is not a line.
 const MIN_NEW_LINE_PX: f64 = 3.0;

@@ -6,9 +6,9 @@ use morphfx::scene::edit::Document;
 
 use crate::nodes::params::{Reader, SCENE_FILE, SCENE_TEXT};
 use crate::nodes::state::NodeState;
-use crate::sync::Locked;
-use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::{Failure, Outcome};
+use ofx_layer::clips::EffectHandle;
+use ofx_layer::sync::Locked;
+use ofx_layer::{Failure, Outcome};
 
 /// The id of the message shown while the viewer refuses to edit.
 const REFUSED: &std::ffi::CStr = c"net.morphfx.overlay.refused";

@@ -7,7 +7,7 @@ use morphfx::geom::Vec2;
 use morphfx::scene::edit::Document;
 
 use crate::nodes::params::{EditSides, Show};
-use crate::wrapper::plugin::Pen;
+use ofx_layer::plugin::Pen;
 
 /// Where a feature lives, which says how an edit reaches it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

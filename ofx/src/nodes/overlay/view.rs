@@ -9,11 +9,11 @@ use crate::nodes::inputs::{load_scene, warp_inputs};
 use crate::nodes::lines::slot_lines;
 use crate::nodes::params::{Reader, Settings, Show, OVERLAY_SHOW};
 use crate::nodes::state::NodeState;
-use crate::sync::Locked;
-use crate::wrapper::paint::Painter;
-use crate::wrapper::plugin::DrawArgs;
-use crate::wrapper::Outcome;
-use crate::wrapper::Reply;
+use ofx_layer::paint::Painter;
+use ofx_layer::plugin::DrawArgs;
+use ofx_layer::sync::Locked;
+use ofx_layer::Outcome;
+use ofx_layer::Reply;
 
 /// Every feature of the node at `time`, with the progress and the frames
 /// Scene Text's shapes are keyed at. A scene that does not parse is drawn

@@ -6,9 +6,9 @@ use morphfx::choice::Choice;
 use morphfx::geom::Vec2;
 
 use crate::nodes::kind::NodeKind;
-use crate::wrapper::params::Params;
-use crate::wrapper::spec::{Kind, ParamSpec};
-use crate::wrapper::Outcome;
+use ofx_layer::params::Params;
+use ofx_layer::spec::{Kind, ParamSpec};
+use ofx_layer::Outcome;
 
 use super::ids::{Bool, Choose, Double, Id, Indexed, Int, Point, Text};
 use super::table::spec;

@@ -13,7 +13,7 @@ use morphfx::warp::mffd::MffdSettings;
 use morphfx::warp::thin_plate::ThinPlateSettings;
 
 use crate::nodes::kind::NodeKind;
-use crate::wrapper::params::Params;
+use ofx_layer::params::Params;
 
 use super::choices::{Affects, EvaluationMode, PATTERNS};
 use super::ids::*;

@@ -16,9 +16,9 @@ use morphfx::warp::mffd::MffdSettings;
 use morphfx::warp::thin_plate::ThinPlateSettings;
 
 use crate::nodes::kind::NodeKind;
-use crate::sync::Locked;
-use crate::wrapper::plugin::Context;
-use crate::wrapper::spec::{Kind, ParamSpec, TextMode};
+use ofx_layer::plugin::Context;
+use ofx_layer::spec::{Kind, ParamSpec, TextMode};
+use ofx_layer::sync::Locked;
 
 use super::choices::{pattern_label, Affects, DrawTool, EditSides, EvaluationMode, Show, PATTERNS};
 use super::ids::*;

@@ -4,7 +4,7 @@ use morphfx::make_warp::Method;
 use morphfx::views::View;
 use morphfx::warp::field::FieldSettings;
 
-use crate::wrapper::spec::Kind;
+use ofx_layer::spec::Kind;
 
 use super::ids::*;
 use super::settings::*;

@@ -11,7 +11,7 @@ use morphfx::views::{self, View};
 use morphfx::warp::mesh::{self, MeshPair};
 
 use crate::nodes::state::PLANES_KEPT;
-use crate::sync::Locked;
+use ofx_layer::sync::Locked;
 
 pub(super) struct Job<'a> {
     pub(super) view: View,

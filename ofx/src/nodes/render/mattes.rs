@@ -10,8 +10,8 @@ use morphfx::transition::{Matte, Transition, TransitionSettings};
 
 use crate::nodes::kind::TIMING_CLIP;
 use crate::nodes::params::{pacing, Settings};
-use crate::wrapper::clips::{Depth, HostImage};
-use crate::wrapper::{Failure, Outcome};
+use ofx_layer::clips::{Depth, HostImage};
+use ofx_layer::{Failure, Outcome};
 
 /// The timing matte of `image`: its alpha (an RGB matte's mean) per pixel.
 pub(super) fn timing_matte(image: &HostImage) -> Outcome<Matte> {

@@ -27,10 +27,10 @@ use crate::nodes::inputs::{warp_inputs, WarpInputs};
 use crate::nodes::kind::{NodeKind, MASK_CLIP, TIMING_CLIP};
 use crate::nodes::params::Settings;
 use crate::nodes::state::NodeState;
-use crate::wrapper::clips::{Depth, EffectHandle, HostImage, HostSample};
-use crate::wrapper::plugin::RenderArgs;
-use crate::wrapper::{Failure, Outcome};
 use draw::Job;
+use ofx_layer::clips::{Depth, EffectHandle, HostImage, HostSample};
+use ofx_layer::plugin::RenderArgs;
+use ofx_layer::{Failure, Outcome};
 pub use regions::{
     clip_preferences, frames_needed, is_identity, region_of_definition, regions_of_interest,
 };
@@ -571,10 +571,10 @@ mod tests {
     use super::*;
     use crate::nodes::node::Node;
     use crate::nodes::{Morph, Warp};
-    use crate::wrapper::params::Params;
-    use crate::wrapper::plugin::Context;
     use morphfx::features::Feature;
     use morphfx::make_warp::WarpSettings;
+    use ofx_layer::params::Params;
+    use ofx_layer::plugin::Context;
 
     fn source(premultiplied: bool) -> Option<Source> {
         Some(Source {

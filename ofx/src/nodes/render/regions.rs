@@ -9,9 +9,9 @@ use crate::nodes::inputs::{warp_inputs, WarpInputs};
 use crate::nodes::kind::{NodeKind, MASK_CLIP, TIMING_CLIP};
 use crate::nodes::params::{Reader, Settings, OFFSET_A, OFFSET_B, VIEW};
 use crate::nodes::state::NodeState;
-use crate::wrapper::clips::EffectHandle;
-use crate::wrapper::plugin::{ClipPreferences, FramesNeeded, Identity, RenderArgs, Rois};
-use crate::wrapper::{Outcome, Reply};
+use ofx_layer::clips::EffectHandle;
+use ofx_layer::plugin::{ClipPreferences, FramesNeeded, Identity, RenderArgs, Rois};
+use ofx_layer::{Outcome, Reply};
 
 /// Each source clip and the time it is read at for output time `time`
 /// (its frame offset added).

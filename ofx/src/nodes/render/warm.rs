@@ -16,8 +16,8 @@ use morphfx::warp::thin_plate::ThinPlateWarp;
 use crate::cache::Key;
 use crate::nodes::inputs::WarpInputs;
 use crate::nodes::state::{NodeState, GRIDS_KEPT, PLATES_KEPT};
-use crate::sync::Locked;
-use crate::wrapper::{Failure, Outcome};
+use ofx_layer::sync::Locked;
+use ofx_layer::{Failure, Outcome};
 
 /// The frame's `auto` correspondence: solved once per content of the two
 /// images and settings (tiles and repeated renders share it), warm-started
@@ -67,7 +67,7 @@ pub(super) fn correspondence(
             warm.as_ref(),
         )
         .map_err(|e| Failure::BadInput(e.to_string()))?;
-        if crate::wrapper::verbose() {
+        if ofx_layer::verbose() {
             eprintln!(
                 "auto: frame {time}: {}x{} to {}x{}, {} start, {:.2} s\n{}",
                 a.width,
@@ -124,7 +124,7 @@ pub(super) fn thin_plate(
         warm.as_deref(),
     )
     .map_err(|e| Failure::BadInput(e.to_string()))?;
-    if crate::wrapper::verbose() {
+    if ofx_layer::verbose() {
         let cycles = |r: &Report| r.residuals.len() - 1;
         eprintln!(
             "thin-plate: frame {time} side {side:?}: {} start, {} + {} cycles",

@@ -1,5 +1,5 @@
 //! Params as data: stable ids, labels, hints, defaults, ranges,
-//! groups. The wrapper turns a table of these into OFX param definitions.
+//! groups. The layer turns a table of these into OFX param definitions.
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum TextMode {

@@ -1,5 +1,5 @@
 //! The three symbols a host looks up, made for a list of node types by
-//! [`export!`](crate::wrapper::export): `OfxSetHost` (which must return an
+//! [`export!`](crate::export): `OfxSetHost` (which must return an
 //! `OfxStatus`, which the `openfx` crate's export macro gets wrong),
 //! `OfxGetNumberOfPlugins` and `OfxGetPlugin`. Each hands over to the fast
 //! build where the CPU runs it (see `cpu.rs`).
@@ -78,33 +78,33 @@ pub fn get(plugins: &Plugins, nth: c_int) -> *mut OfxPlugin {
 /// Exports the bundle's node types, in the order hosts list them: the
 /// plugin structs and the three symbols a host looks up. The composition
 /// root names its nodes once, here.
+#[macro_export]
 macro_rules! export {
     ($($node:ty),+ $(,)?) => {
-        static PLUGINS: $crate::wrapper::exports::Plugins =
-            $crate::wrapper::exports::Plugins(&[$($crate::wrapper::exports::plugin::<$node>()),+]);
+        static PLUGINS: $crate::exports::Plugins =
+            $crate::exports::Plugins(&[$($crate::exports::plugin::<$node>()),+]);
 
         /// # Safety
         /// Called by OFX hosts with a valid host struct (or null, refused).
         #[unsafe(no_mangle)]
         pub unsafe extern "C" fn OfxSetHost(
-            host: *const openfx::sys::generic::core::OfxHost,
-        ) -> openfx::sys::generic::core::OfxStatus {
+            host: *const $crate::sys::generic::core::OfxHost,
+        ) -> $crate::sys::generic::core::OfxStatus {
             // SAFETY: this function's own contract.
-            unsafe { $crate::wrapper::exports::set_host(host) }
+            unsafe { $crate::exports::set_host(host) }
         }
 
         #[unsafe(no_mangle)]
         pub extern "C" fn OfxGetNumberOfPlugins() -> std::ffi::c_int {
-            std::panic::catch_unwind(|| $crate::wrapper::exports::count(&PLUGINS)).unwrap_or(0)
+            std::panic::catch_unwind(|| $crate::exports::count(&PLUGINS)).unwrap_or(0)
         }
 
         #[unsafe(no_mangle)]
         pub extern "C" fn OfxGetPlugin(
             nth: std::ffi::c_int,
-        ) -> *mut openfx::sys::generic::core::OfxPlugin {
-            std::panic::catch_unwind(|| $crate::wrapper::exports::get(&PLUGINS, nth))
+        ) -> *mut $crate::sys::generic::core::OfxPlugin {
+            std::panic::catch_unwind(|| $crate::exports::get(&PLUGINS, nth))
                 .unwrap_or(std::ptr::null_mut())
         }
     };
 }
-pub(crate) use export;

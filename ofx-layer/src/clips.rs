@@ -202,7 +202,7 @@ impl EffectHandle {
 
     /// As [`EffectHandle::persistent_error`], a warning: something refused
     /// that leaves the node working (hosts show no error badge for it).
-    pub(crate) fn persistent_warning(&self, id: &CStr, text: &str) -> bool {
+    pub fn persistent_warning(&self, id: &CStr, text: &str) -> bool {
         self.persistent(kOfxMessageWarning, id, text)
     }
 
@@ -226,7 +226,7 @@ impl EffectHandle {
     }
 
     /// Clears the persistent message set by [`EffectHandle::persistent_error`].
-    pub(crate) fn clear_persistent(&self) {
+    pub fn clear_persistent(&self) {
         if let Some(f) = self
             .suites
             .message_v2

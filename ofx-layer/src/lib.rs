@@ -22,8 +22,12 @@ pub mod params;
 pub mod plugin;
 mod props;
 pub mod spec;
+pub mod sync;
 
-pub(crate) use exports::export;
+/// The OpenFX bindings the [`export!`] macro names.
+#[doc(hidden)]
+pub use openfx::sys;
+
 pub use host::verbose;
 
 use std::ffi::{CStr, CString};
@@ -49,7 +53,7 @@ pub const BAD_INPUT_ID: &CStr = c"net.morphfx.BadInput";
 pub type Outcome<T = ()> = Result<T, Failure>;
 
 /// How an action that did not fail ended: the nodes answer this, never an
-/// `OfxStatus` (the wrapper alone speaks statuses).
+/// `OfxStatus` (the layer alone speaks statuses).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reply {
     /// Done (`kOfxStatOK`).

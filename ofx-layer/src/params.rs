@@ -350,9 +350,9 @@ unsafe impl Send for Params {}
 unsafe impl Sync for Params {}
 
 impl Params {
-    /// Params bound to no host (tests of what nodes compute without one):
-    /// every read and write fails as for a param the host never made.
-    #[cfg(test)]
+    /// Params bound to no host (what a node computes without one, as its
+    /// tests do): every read and write fails as for a param the host never
+    /// made.
     pub fn unbound() -> Params {
         // SAFETY: every field of the suite is an `Option` of a function
         // pointer, for which all-zero bytes are `None`.
