@@ -7,7 +7,7 @@ use openfx::sys::generic::core::*;
 use openfx::sys::image_effect_v1::param::*;
 
 use super::props::PropSet;
-use super::spec::{Kind, ParamSpec, TextMode};
+use super::spec::{Double, Id, IntValued, Kind, ParamSpec, Point, Text, TextMode};
 use super::{check, host, Failure, Outcome};
 
 fn cstr(s: &str) -> CString {
@@ -64,11 +64,11 @@ impl ParamSet {
         let handles = specs
             .into_iter()
             .filter_map(|spec| {
-                let handle = self.handle(&spec.id).ok()?;
+                let handle = self.handle(spec.id()).ok()?;
                 let kind = self
                     .host_type(handle)
-                    .unwrap_or_else(|| ParamType::declared(&spec.kind));
-                Some((spec.id.clone(), Param { handle, kind }))
+                    .unwrap_or_else(|| ParamType::declared(spec.kind()));
+                Some((spec.id().to_owned(), Param { handle, kind }))
             })
             .collect();
         Params {
@@ -114,7 +114,7 @@ impl ParamSet {
 
 fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &ParamSpec) -> Outcome {
     let define = need(suite.paramDefine, "paramDefine")?;
-    let kind: &CStr = match &spec.kind {
+    let kind: &CStr = match spec.kind() {
         Kind::Double { .. } => kOfxParamTypeDouble,
         Kind::Int { .. } => kOfxParamTypeInteger,
         Kind::Bool { .. } => kOfxParamTypeBoolean,
@@ -125,15 +125,15 @@ fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &Para
         Kind::Button => kOfxParamTypePushButton,
         Kind::HostDriven { .. } => kOfxParamTypeDouble,
     };
-    let name = cstr(&spec.id);
+    let name = cstr(spec.id());
     let mut props: OfxPropertySetHandle = std::ptr::null_mut();
     // SAFETY: param_set came from the host's getParamSet for this descriptor;
     // type and name are NUL-terminated; `props` is a live out-pointer.
     let status = unsafe { define(param_set, kind.as_ptr(), name.as_ptr(), &mut props) };
-    check(status, &format!("defining param {}", spec.id))?;
+    check(status, &format!("defining param {}", spec.id()))?;
     // SAFETY: the host just returned the new param's properties.
     let p = unsafe { PropSet::from_raw(props)? };
-    if let Kind::HostDriven { default } = spec.kind {
+    if let &Kind::HostDriven { default } = spec.kind() {
         p.set_double(kOfxParamPropDefault, 0, default)?;
         let _ = p.set_double(kOfxParamPropMin, 0, 0.0);
         let _ = p.set_double(kOfxParamPropMax, 0, 1.0);
@@ -142,20 +142,20 @@ fn define(param_set: OfxParamSetHandle, suite: &OfxParameterSuiteV1, spec: &Para
         return Ok(());
     }
     set_common(&p, spec)?;
-    set_kind(&p, &spec.kind)
+    set_kind(&p, spec.kind())
 }
 
 /// Label, hint, script name, parent and animation: what every visible param has.
 fn set_common(p: &PropSet, spec: &ParamSpec) -> Outcome {
-    p.set_string(kOfxPropLabel, 0, &spec.label)?;
+    p.set_string(kOfxPropLabel, 0, spec.label())?;
     // Optional properties: a minimal host may not know them; defining still succeeds.
-    let _ = p.set_string(kOfxParamPropHint, 0, &spec.hint);
-    let _ = p.set_string(kOfxParamPropScriptName, 0, &spec.id);
-    if let Some(g) = &spec.group {
+    let _ = p.set_string(kOfxParamPropHint, 0, spec.hint());
+    let _ = p.set_string(kOfxParamPropScriptName, 0, spec.id());
+    if let Some(g) = &spec.group() {
         let _ = p.set_string(kOfxParamPropParent, 0, g);
     }
-    if !matches!(spec.kind, Kind::Group { .. }) {
-        let _ = p.set_int(kOfxParamPropAnimates, 0, spec.animates as i32);
+    if !matches!(spec.kind(), Kind::Group { .. }) {
+        let _ = p.set_int(kOfxParamPropAnimates, 0, spec.animates() as i32);
     }
     Ok(())
 }
@@ -370,7 +370,8 @@ impl Params {
 
     /// Whether the host made param `id` (a minimal host may not make every
     /// kind the plugin defines).
-    pub fn has(&self, id: &str) -> bool {
+    pub fn has<K>(&self, id: &Id<K>) -> bool {
+        let id = id.name();
         self.handles.contains_key(id)
     }
 
@@ -416,7 +417,8 @@ impl Params {
         Ok((h, f))
     }
 
-    pub fn double(&self, id: &str, time: f64) -> Outcome<f64> {
+    pub fn double(&self, id: &Id<Double>, time: f64) -> Outcome<f64> {
+        let id = id.name();
         let (h, f) = self.get_at(id, Values::OneDouble)?;
         let mut v = 0.0f64;
         // SAFETY: `h` is a Double param (checked by `typed`), which takes
@@ -427,7 +429,8 @@ impl Params {
     }
 
     /// Integer, boolean and choice params all take one `int*`.
-    pub fn int(&self, id: &str, time: f64) -> Outcome<i32> {
+    pub fn int<K: IntValued>(&self, id: &Id<K>, time: f64) -> Outcome<i32> {
+        let id = id.name();
         let (h, f) = self.get_at(id, Values::OneInt)?;
         let mut v: c_int = 0;
         // SAFETY: `h` is an Integer, Boolean or Choice param (checked by
@@ -437,7 +440,8 @@ impl Params {
         Ok(v)
     }
 
-    pub fn point(&self, id: &str, time: f64) -> Outcome<(f64, f64)> {
+    pub fn point(&self, id: &Id<Point>, time: f64) -> Outcome<(f64, f64)> {
+        let id = id.name();
         let (h, f) = self.get_at(id, Values::TwoDoubles)?;
         let (mut x, mut y) = (0.0f64, 0.0f64);
         // SAFETY: `h` is a Double2D param (checked by `typed`), which
@@ -448,7 +452,8 @@ impl Params {
     }
 
     /// Keys a Double2D param at `time` (the host adds or moves the key).
-    pub fn set_point_at(&self, id: &str, time: f64, (x, y): (f64, f64)) -> Outcome {
+    pub fn set_point_at(&self, id: &Id<Point>, time: f64, (x, y): (f64, f64)) -> Outcome {
+        let id = id.name();
         let h = self.typed(id, Values::TwoDoubles)?;
         let f = need(self.set.suite.paramSetValueAtTime, "paramSetValueAtTime")?;
         // SAFETY: `h` is a Double2D param (checked by `typed`), which
@@ -457,7 +462,8 @@ impl Params {
     }
 
     /// Sets a Double2D param's value (a param without keys).
-    pub fn set_point(&self, id: &str, (x, y): (f64, f64)) -> Outcome {
+    pub fn set_point(&self, id: &Id<Point>, (x, y): (f64, f64)) -> Outcome {
+        let id = id.name();
         let h = self.typed(id, Values::TwoDoubles)?;
         let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
         // SAFETY: `h` is a Double2D param (checked by `typed`), which
@@ -466,7 +472,8 @@ impl Params {
     }
 
     /// Sets an Integer, Boolean or Choice param's value.
-    pub fn set_int(&self, id: &str, v: i32) -> Outcome {
+    pub fn set_int<K: IntValued>(&self, id: &Id<K>, v: i32) -> Outcome {
+        let id = id.name();
         let h = self.typed(id, Values::OneInt)?;
         let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
         // SAFETY: `h` is an Integer, Boolean or Choice param (checked by
@@ -476,7 +483,8 @@ impl Params {
 
     /// Sets a String param's value. A string with a NUL in it cannot cross
     /// the C ABI and is refused.
-    pub fn set_string(&self, id: &str, v: &str) -> Outcome {
+    pub fn set_string(&self, id: &Id<Text>, v: &str) -> Outcome {
+        let id = id.name();
         let h = self.typed(id, Values::OneString)?;
         let f = need(self.set.suite.paramSetValue, "paramSetValue")?;
         let v = CString::new(v)
@@ -491,7 +499,7 @@ impl Params {
     /// already animates (other keys stay), set outright when it has none,
     /// or when the host cannot count keys (the OpenFX reference host
     /// library answers `kOfxStatErrMissingHostFeature`).
-    pub fn move_point(&self, id: &str, time: f64, p: (f64, f64)) -> Outcome {
+    pub fn move_point(&self, id: &Id<Point>, time: f64, p: (f64, f64)) -> Outcome {
         if self.num_keys(id).is_ok_and(|n| n > 0) {
             self.set_point_at(id, time, p)
         } else {
@@ -500,7 +508,8 @@ impl Params {
     }
 
     /// How many keys the param has.
-    pub fn num_keys(&self, id: &str) -> Outcome<u32> {
+    pub fn num_keys<K>(&self, id: &Id<K>) -> Outcome<u32> {
+        let id = id.name();
         let f = need(self.set.suite.paramGetNumKeys, "paramGetNumKeys")?;
         let h = self.handle(id)?;
         let mut n: std::ffi::c_uint = 0;
@@ -510,8 +519,9 @@ impl Params {
     }
 
     /// The times of the param's keys, in order.
-    pub fn key_times(&self, id: &str) -> Outcome<Vec<f64>> {
+    pub fn key_times<K>(&self, id: &Id<K>) -> Outcome<Vec<f64>> {
         let n = self.num_keys(id)?;
+        let id = id.name();
         let f = need(self.set.suite.paramGetKeyTime, "paramGetKeyTime")?;
         let h = self.handle(id)?;
         (0..n)
@@ -526,7 +536,8 @@ impl Params {
     }
 
     /// Removes every key of the param (its value stays what it was).
-    pub fn delete_all_keys(&self, id: &str) -> Outcome {
+    pub fn delete_all_keys<K>(&self, id: &Id<K>) -> Outcome {
+        let id = id.name();
         let f = need(self.set.suite.paramDeleteAllKeys, "paramDeleteAllKeys")?;
         let h = self.handle(id)?;
         // SAFETY: the param's handle.
@@ -534,7 +545,8 @@ impl Params {
     }
 
     /// Hides or shows the param in the host's UI (`kOfxParamPropSecret`).
-    pub fn set_secret(&self, id: &str, secret: bool) -> Outcome {
+    pub fn set_secret<K>(&self, id: &Id<K>, secret: bool) -> Outcome {
+        let id = id.name();
         let f = need(self.set.suite.paramGetPropertySet, "paramGetPropertySet")?;
         let h = self.handle(id)?;
         let mut props: OfxPropertySetHandle = std::ptr::null_mut();
@@ -616,7 +628,8 @@ impl Params {
         closed.map(|()| value)
     }
 
-    pub fn string(&self, id: &str, time: f64) -> Outcome<String> {
+    pub fn string(&self, id: &Id<Text>, time: f64) -> Outcome<String> {
+        let id = id.name();
         let (h, f) = self.get_at(id, Values::OneString)?;
         let mut v: *const c_char = std::ptr::null();
         // SAFETY: `h` is a String param (checked by `typed`), which takes

@@ -13,7 +13,7 @@ use super::clips::EffectHandle;
 pub use super::context::Context;
 use super::paint::Painter;
 use super::params::Params;
-use super::spec::ParamSpec;
+use super::spec::{Id, ParamSpec};
 use super::{Outcome, Reply};
 
 /// The sample depths a node renders.
@@ -116,6 +116,13 @@ pub struct Identity {
 pub struct ParamChange {
     pub name: String,
     pub time: f64,
+}
+
+impl ParamChange {
+    /// Whether the param that changed is `id`.
+    pub fn is<K>(&self, id: &Id<K>) -> bool {
+        self.name == id.name()
+    }
 }
 
 /// A region of interest per input clip, set by the node.

@@ -92,7 +92,7 @@ pub(in crate::nodes) fn warp_inputs(
     if instance.context == Context::Transition {
         t = instance
             .params()
-            .double(TRANSITION_PARAM.name(), time)?
+            .double(&TRANSITION_PARAM, time)?
             .clamp(0.0, 1.0);
     }
     Ok(WarpInputs { features, warp, t })

@@ -6,10 +6,10 @@ use morphfx::geom::Vec2;
 
 use super::kind::NodeKind;
 use super::params::{
-    slot_clear, slot_group, slot_ids, spec, Id, Point, Reader, SlotIds, LINE_COUNT, LINE_SLOTS,
+    slot_clear, slot_group, slot_ids, spec, Reader, SlotIds, LINE_COUNT, LINE_SLOTS,
 };
 use ofx_layer::params::Params;
-use ofx_layer::spec::Kind;
+use ofx_layer::spec::{Id, Kind, Point};
 use ofx_layer::Outcome;
 
 /// One enabled slot's lines at a time: A's and B's, start then end.
@@ -81,24 +81,24 @@ pub fn clear(kind: &'static NodeKind, params: &Params, k: usize, time: f64) -> O
                 let id = end_id(k, side, end);
                 // A host without keyframes (or without this call) has no
                 // keys to delete: the value below is all there is.
-                let _ = params.delete_all_keys(id.name());
-                params.set_point(id.name(), default_point(kind, &id))?;
+                let _ = params.delete_all_keys(&id);
+                params.set_point(&id, default_point(kind, &id))?;
             }
         }
-        params.set_int(enable.name(), 0)?;
+        params.set_int(&enable, 0)?;
         let r = Reader::new(params, kind, time);
         let mut count = r.int(&LINE_COUNT).max(0) as usize;
         while count > 0 && !r.bool(&slot_ids(count).enable) {
             count -= 1;
         }
-        params.set_int(LINE_COUNT.name(), count as i32)
+        params.set_int(&LINE_COUNT, count as i32)
     })?;
     hide_unused(kind, params, time);
     Ok(())
 }
 
 fn default_point(kind: &'static NodeKind, id: &Id<Point>) -> (f64, f64) {
-    match spec(kind, id.name()).map(|p| &p.kind) {
+    match spec(kind, id.name()).map(|p| p.kind()) {
         Some(Kind::Point { default }) => *default,
         _ => (0.0, 0.0),
     }
@@ -110,9 +110,12 @@ pub fn hide_unused(kind: &'static NodeKind, params: &Params, time: f64) {
     let count = Reader::new(params, kind, time).int(&LINE_COUNT).max(0) as usize;
     for k in 1..=LINE_SLOTS {
         let secret = k > count;
+        let ids = slot_ids(k);
         let _ = params.set_secret(&slot_group(k), secret);
-        for id in slot_ids(k).names().iter().chain([&slot_clear(k)]) {
+        let _ = params.set_secret(&ids.enable, secret);
+        for id in ids.ends() {
             let _ = params.set_secret(id, secret);
         }
+        let _ = params.set_secret(&slot_clear(k), secret);
     }
 }

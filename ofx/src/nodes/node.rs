@@ -162,26 +162,26 @@ impl<N: Node> ImageEffect for Effect<N> {
 
 /// A param changed: the buttons act, Line Count shows its slots.
 fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) -> Outcome {
-    let (name, time) = (change.name.as_str(), change.time);
-    if name == params::SNAP_LINES.name() {
+    let time = change.time;
+    if change.is(&params::SNAP_LINES) {
         snap::snap_lines(node, effect, time)
-    } else if name == params::TRACK_FORWARD.name() {
+    } else if change.is(&params::TRACK_FORWARD) {
         track::track_lines(node, effect, time, 1)
-    } else if name == params::TRACK_BACKWARD.name() {
+    } else if change.is(&params::TRACK_BACKWARD) {
         track::track_lines(node, effect, time, -1)
-    } else if name == params::FINISH_SHAPE.name() {
+    } else if change.is(&params::FINISH_SHAPE) {
         overlay::finish_shape(node);
         Ok(())
-    } else if name == params::DELETE_SHAPE.name() {
+    } else if change.is(&params::DELETE_SHAPE) {
         overlay::delete_shape(node, effect, time)
-    } else if name == params::KEY_SHAPES.name() {
+    } else if change.is(&params::KEY_SHAPES) {
         overlay::shapes::key_here(node, effect, time)
-    } else if name == params::COPY_SCENE.name() {
+    } else if change.is(&params::COPY_SCENE) {
         overlay::shapes::copy_scene(node, effect, time)
-    } else if name == params::LINE_COUNT.name() {
+    } else if change.is(&params::LINE_COUNT) {
         lines::hide_unused(node.kind, node.params(), time);
         Ok(())
-    } else if let Some(k) = params::clear_button_slot(name) {
+    } else if let Some(k) = params::clear_button_slot(&change.name) {
         lines::clear(node.kind, node.params(), k, time)
     } else {
         Ok(())

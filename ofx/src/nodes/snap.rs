@@ -43,8 +43,8 @@ pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
         }
         let sides = std::iter::once((a, &energy_a)).chain(energy_b.as_ref().map(|e| (b, e)));
         for ([start, end], (energy, scale)) in sides {
-            let p = Vec2::from(<[f64; 2]>::from(params.point(start.name(), time)?));
-            let q = Vec2::from(<[f64; 2]>::from(params.point(end.name(), time)?));
+            let p = Vec2::from(<[f64; 2]>::from(params.point(&start, time)?));
+            let q = Vec2::from(<[f64; 2]>::from(params.point(&end, time)?));
             if p == q || !(p.is_finite() && q.is_finite()) {
                 continue;
             }
@@ -72,7 +72,7 @@ pub fn snap_lines(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
     }
     params.edit_block("Snap Lines", || {
         keys.iter()
-            .try_for_each(|(id, p)| params.set_point_at(id.name(), time, (p.x, p.y)))?;
+            .try_for_each(|(id, p)| params.set_point_at(id, time, (p.x, p.y)))?;
         match &doc {
             Some(doc) => shapes::write(instance, doc),
             None => Ok(()),

@@ -208,7 +208,7 @@ fn stop_frame(
         .flat_map(|(side, _)| lines.iter().map(move |l| (l.slot, *side)))
         .flat_map(|(slot, side)| (0..2).map(move |end| end_id(slot, side, end)))
         // A host that cannot list keys: the clip's end decides.
-        .flat_map(|id| params.key_times(id.name()).unwrap_or_default())
+        .flat_map(|id| params.key_times(&id).unwrap_or_default())
         .chain(shape_keys.iter().copied())
         .filter(|t| (t - time) * dir > 0.5)
         .min_by(|x, y| ((x - time) * dir).total_cmp(&((y - time) * dir)));
@@ -269,7 +269,7 @@ fn sweep(
                     Target::Slot(slot) => {
                         for (end, at) in found.enumerate() {
                             let id = end_id(slot, f.side, end);
-                            params.set_point_at(id.name(), frame, (at.x, at.y))?;
+                            params.set_point_at(&id, frame, (at.x, at.y))?;
                         }
                     }
                     Target::Shape(i) => shape_keys.push((frame, i, f.side, found.collect())),

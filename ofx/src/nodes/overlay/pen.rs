@@ -119,8 +119,8 @@ fn start_new_line(instance: &NodeState, pen: Pen) -> Outcome<Option<Drag>> {
     }
     let slot = count as usize + 1;
     params.begin_edit(&format!("New Line {slot}"))?;
-    params.set_int(LINE_COUNT.name(), slot as i32)?;
-    params.set_int(slot_ids(slot).enable.name(), 1)?;
+    params.set_int(&LINE_COUNT, slot as i32)?;
+    params.set_int(&slot_ids(slot).enable, 1)?;
     Ok(Some(Drag::NewLine {
         slot,
         start: pen.at,
@@ -205,18 +205,18 @@ fn write_drag(instance: &NodeState, drag: &Drag, pen: Pen) -> Outcome {
         } => {
             let id = |end| end_id(*slot, *side, end);
             match *part {
-                Part::Point(end) => params.move_point(id(end).name(), pen.time, xy(pen.at)),
+                Part::Point(end) => params.move_point(&id(end), pen.time, xy(pen.at)),
                 Part::Body { .. } => {
                     let d = pen.at - *from;
-                    params.move_point(id(0).name(), pen.time, xy(ends[0] + d))?;
-                    params.move_point(id(1).name(), pen.time, xy(ends[1] + d))
+                    params.move_point(&id(0), pen.time, xy(ends[0] + d))?;
+                    params.move_point(&id(1), pen.time, xy(ends[1] + d))
                 }
             }
         }
         Drag::NewLine { slot, start, .. } => {
             for side in [Side::A, Side::B] {
-                params.move_point(end_id(*slot, side, 0).name(), pen.time, xy(*start))?;
-                params.move_point(end_id(*slot, side, 1).name(), pen.time, xy(pen.at))?;
+                params.move_point(&end_id(*slot, side, 0), pen.time, xy(*start))?;
+                params.move_point(&end_id(*slot, side, 1), pen.time, xy(pen.at))?;
             }
             Ok(())
         }
@@ -294,7 +294,7 @@ pub fn up(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Repl
             count_before,
             ..
         } if screen_length(*start, pen.at, pixel) < MIN_NEW_LINE_PX => {
-            params.set_int(LINE_COUNT.name(), *count_before)
+            params.set_int(&LINE_COUNT, *count_before)
         }
         _ => write_drag(instance, &drag, pen),
     };

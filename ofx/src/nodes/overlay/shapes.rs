@@ -32,7 +32,7 @@ pub fn document(instance: &NodeState, time: f64) -> Outcome<Document> {
 
 /// Writes `doc` into Scene Text.
 pub fn write(instance: &NodeState, doc: &Document) -> Outcome {
-    instance.params().set_string(SCENE_TEXT.name(), &doc.text())
+    instance.params().set_string(&SCENE_TEXT, &doc.text())
 }
 
 /// Shows why an edit was refused on the node until the next edit that
@@ -81,8 +81,8 @@ pub fn copy_scene(instance: &NodeState, effect: &EffectHandle, time: f64) -> Out
                 Failure::BadInput(format!("Copy Scene Into Node: scene file {path}: {e}"))
             })?;
             params.edit_block("Copy Scene Into Node", || {
-                params.set_string(SCENE_TEXT.name(), &text)?;
-                params.set_string(SCENE_FILE.name(), "")
+                params.set_string(&SCENE_TEXT, &text)?;
+                params.set_string(&SCENE_FILE, "")
             })
         });
     settle(instance, effect, result)

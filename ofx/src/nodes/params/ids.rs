@@ -1,76 +1,14 @@
 //! The params' ids: stable names hosts save projects by, each typed with
-//! the kind of value the param holds, so every read and write through an id
-//! is checked when the plugin is compiled.
-
-use std::borrow::Cow;
-use std::marker::PhantomData;
+//! the kind of value the param holds, so every row, read and write through
+//! an id is checked when the plugin is compiled.
 
 use morphfx::image::{EdgeMode, Filter};
 use morphfx::warp::field::LineInterpolation;
 use morphfx::warp::mesh::Pass;
 
+use ofx_layer::spec::{Bool, Button, Choose, Double, Group, Id, Indexed, Int, Point, Text};
+
 use super::choices::{Affects, DrawTool, EditSides, EvaluationMode, Show};
-
-/// A param's id, typed with the kind of value it holds (`Double`, `Int`,
-/// `Bool`, `Text`, `Point`, `Choose<C>`, `Indexed`, `Button`).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Id<K> {
-    name: Cow<'static, str>,
-    kind: PhantomData<fn() -> K>,
-}
-
-impl<K> Id<K> {
-    pub const fn new(name: &'static str) -> Self {
-        Id {
-            name: Cow::Borrowed(name),
-            kind: PhantomData,
-        }
-    }
-
-    fn owned(name: String) -> Self {
-        Id {
-            name: Cow::Owned(name),
-            kind: PhantomData,
-        }
-    }
-
-    /// The id as hosts know it.
-    pub fn name(&self) -> &str {
-        &self.name
-    }
-}
-
-impl<K> From<Id<K>> for String {
-    fn from(id: Id<K>) -> String {
-        id.name.into_owned()
-    }
-}
-
-/// A floating-point param.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Double;
-/// An integer param.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Int;
-/// A boolean param.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Bool;
-/// A string param.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Text;
-/// A canonical position (Double2D).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Point;
-/// A push button: it has no value, only presses.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Button;
-/// A choice whose options are `C`'s, in `Choice::ALL` order.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Choose<C>(PhantomData<C>);
-/// A choice whose options depend on the node (methods, views, patterns):
-/// read by index into the list the table defined it with.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Indexed;
 
 /// Line-pair slots every node offers (a face takes 30 to 60 lines).
 pub const LINE_SLOTS: usize = 64;
@@ -122,14 +60,23 @@ pub const TRANSITION_CYCLES: Id<Double> = Id::new("transition_cycles");
 pub const MASK_INVERT: Id<Bool> = Id::new("mask_invert");
 pub const MIX: Id<Double> = Id::new("mix");
 
+/// The groups, as hosts fold them.
+pub const FIELD_GROUP: Id<Group> = Id::new("field_group");
+pub const MESH_GROUP: Id<Group> = Id::new("mesh_group");
+pub const AUTO_GROUP: Id<Group> = Id::new("auto_group");
+pub const SCATTERED_GROUP: Id<Group> = Id::new("scattered_group");
+pub const TRANSITION_GROUP: Id<Group> = Id::new("transition_group");
+pub const LINES_GROUP: Id<Group> = Id::new("lines_group");
+pub const SCENE_GROUP: Id<Group> = Id::new("scene_group");
+
 /// The group holding line slot `k`'s params.
-pub fn slot_group(k: usize) -> String {
-    format!("line{k}_group")
+pub fn slot_group(k: usize) -> Id<Group> {
+    Id::named(format!("line{k}_group"))
 }
 
 /// Line slot `k`'s Clear Line button.
-pub fn slot_clear(k: usize) -> String {
-    format!("line{k}_clear")
+pub fn slot_clear(k: usize) -> Id<Button> {
+    Id::named(format!("line{k}_clear"))
 }
 
 /// The slot whose Clear Line button `id` is.
@@ -167,9 +114,9 @@ impl SlotIds {
 
 /// Line slot `k`'s ids.
 pub fn slot_ids(k: usize) -> SlotIds {
-    let point = |which: &str| Id::owned(format!("line{k}_{which}"));
+    let point = |which: &str| Id::named(format!("line{k}_{which}"));
     SlotIds {
-        enable: Id::owned(format!("line{k}_enable")),
+        enable: Id::named(format!("line{k}_enable")),
         a: [point("a_start"), point("a_end")],
         b: [point("b_start"), point("b_end")],
     }

@@ -7,10 +7,11 @@ use morphfx::geom::Vec2;
 
 use crate::nodes::kind::NodeKind;
 use ofx_layer::params::Params;
-use ofx_layer::spec::{Kind, ParamSpec};
+use ofx_layer::spec::{
+    Bool, Choose, Double, Id, Indexed, Int, IntValued, Kind, ParamSpec, Point, Text,
+};
 use ofx_layer::Outcome;
 
-use super::ids::{Bool, Choose, Double, Id, Indexed, Int, Point, Text};
 use super::table::spec;
 
 /// Reads params at one time, each by the table entry that defines it: the
@@ -42,7 +43,11 @@ impl<'a> Reader<'a> {
     }
 
     /// The host's value, or `None` (and `id` noted missing or unreadable).
-    pub(super) fn host<T>(&self, id: &str, read: impl FnOnce(&Params) -> Outcome<T>) -> Option<T> {
+    pub(super) fn host<K, T>(
+        &self,
+        id: &Id<K>,
+        read: impl FnOnce(&Params) -> Outcome<T>,
+    ) -> Option<T> {
         let params = self.params?;
         match read(params) {
             Ok(v) => Some(v),
@@ -51,19 +56,18 @@ impl<'a> Reader<'a> {
                 None
             }
             Err(_) => {
-                self.missing.borrow_mut().push(id.to_owned());
+                self.missing.borrow_mut().push(id.name().to_owned());
                 None
             }
         }
     }
 
     pub fn double(&self, id: &Id<Double>) -> f64 {
-        let id = id.name();
-        let Kind::Double {
+        let &Kind::Double {
             default, min, max, ..
-        } = self.spec(id).kind
+        } = self.spec(id.name()).kind()
         else {
-            panic!("param {id} is not a double");
+            panic!("param {} is not a double", id.name());
         };
         match self.host(id, |p| p.double(id, self.time)) {
             Some(v) if v.is_finite() => v.clamp(min, max),
@@ -72,18 +76,16 @@ impl<'a> Reader<'a> {
     }
 
     pub fn int(&self, id: &Id<Int>) -> i32 {
-        let id = id.name();
-        let Kind::Int { default, min, max } = self.spec(id).kind else {
-            panic!("param {id} is not an integer");
+        let &Kind::Int { default, min, max } = self.spec(id.name()).kind() else {
+            panic!("param {} is not an integer", id.name());
         };
         self.host(id, |p| p.int(id, self.time))
             .map_or(default, |v| v.clamp(min, max))
     }
 
     pub fn bool(&self, id: &Id<Bool>) -> bool {
-        let id = id.name();
-        let Kind::Bool { default } = self.spec(id).kind else {
-            panic!("param {id} is not a boolean");
+        let &Kind::Bool { default } = self.spec(id.name()).kind() else {
+            panic!("param {} is not a boolean", id.name());
         };
         self.host(id, |p| p.int(id, self.time))
             .map_or(default, |v| v != 0)
@@ -92,12 +94,12 @@ impl<'a> Reader<'a> {
     /// The option of `options` the host's index picks (the list the table
     /// defined the param with), else the declared default.
     pub fn pick<C: Copy>(&self, id: &Id<Indexed>, options: &[C]) -> C {
-        self.index(id.name(), options)
+        self.index(id, options)
     }
 
-    fn index<C: Copy>(&self, id: &str, options: &[C]) -> C {
-        let Kind::Choice { default, .. } = &self.spec(id).kind else {
-            panic!("param {id} is not a choice");
+    fn index<K: IntValued, C: Copy>(&self, id: &Id<K>, options: &[C]) -> C {
+        let Kind::Choice { default, .. } = self.spec(id.name()).kind() else {
+            panic!("param {} is not a choice", id.name());
         };
         self.host(id, |p| p.int(id, self.time))
             .and_then(|i| usize::try_from(i).ok())
@@ -108,13 +110,12 @@ impl<'a> Reader<'a> {
 
     /// A [`Choice`] param, defined with its options in [`Choice::ALL`] order.
     pub fn choice<C: Choice>(&self, id: &Id<Choose<C>>) -> C {
-        self.index(id.name(), C::ALL)
+        self.index(id, C::ALL)
     }
 
     pub fn text(&self, id: &Id<Text>) -> String {
-        let id = id.name();
-        let Kind::Text { default, .. } = self.spec(id).kind else {
-            panic!("param {id} is not text");
+        let &Kind::Text { default, .. } = self.spec(id.name()).kind() else {
+            panic!("param {} is not text", id.name());
         };
         self.host(id, |p| p.string(id, self.time))
             .unwrap_or_else(|| default.to_owned())
@@ -122,9 +123,8 @@ impl<'a> Reader<'a> {
 
     /// A position param, `None` when the host cannot give it.
     pub fn point(&self, id: &Id<Point>) -> Option<Vec2> {
-        let id = id.name();
-        let Kind::Point { .. } = self.spec(id).kind else {
-            panic!("param {id} is not a position");
+        let Kind::Point { .. } = self.spec(id.name()).kind() else {
+            panic!("param {} is not a position", id.name());
         };
         self.host(id, |p| p.point(id, self.time))
             .map(|(x, y)| Vec2::new(x, y))

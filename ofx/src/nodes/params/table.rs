@@ -17,29 +17,11 @@ use morphfx::warp::thin_plate::ThinPlateSettings;
 
 use crate::nodes::kind::NodeKind;
 use ofx_layer::plugin::Context;
-use ofx_layer::spec::{Kind, ParamSpec, TextMode};
+use ofx_layer::spec::{Doubles, Ints, Options, ParamSpec, TextMode, Texts};
 use ofx_layer::sync::Locked;
 
 use super::choices::{pattern_label, Affects, DrawTool, EditSides, EvaluationMode, Show, PATTERNS};
 use super::ids::*;
-
-/// A choice param's kind: `options` labelled by `label`, `default` first
-/// unless said otherwise.
-pub(super) fn choice_of<C: Copy + PartialEq>(
-    options: &[C],
-    label: impl Fn(C) -> &'static str,
-    default: C,
-) -> Kind {
-    Kind::Choice {
-        options: options.iter().map(|o| label(*o)).collect(),
-        default: options.iter().position(|o| *o == default).unwrap_or(0),
-    }
-}
-
-/// A [`Choice`] param's kind, options in [`Choice::ALL`] order.
-pub(super) fn choice<C: Choice>(default: C) -> Kind {
-    choice_of(C::ALL, C::name, default)
-}
 
 /// A node kind's params and their index by id, built once per kind.
 struct Catalogue {
@@ -55,7 +37,10 @@ fn catalogue(kind: &'static NodeKind) -> &'static Catalogue {
     let mut built = BUILT.get_or_init(Default::default).locked();
     built.entry(kind.id).or_insert_with(|| {
         let table = build_table(kind);
-        let index = table.iter().enumerate().map(|(i, p)| (p.id.clone(), i));
+        let index = table
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.id().to_owned(), i));
         let index = index.collect();
         Box::leak(Box::new(Catalogue { table, index }))
     })
@@ -71,97 +56,92 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
     let c = Coefficients::default();
     let tp = ThinPlateSettings::default();
     let mut t = vec![
-        ParamSpec::new(METHOD, "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", choice_of(kind.methods, Method::name, Method::Field)),
-        ParamSpec::new(
-            PROGRESS,
+        METHOD.spec( "Method", "Warp generator. field: line pairs (Beier-Neely); mesh: the scene's mesh (two-pass Catmull-Rom); triangles: every feature point, Delaunay-triangulated, piecewise affine; thin-plate: every feature point pulls two thin plates (x and y displacement) by springs; mffd: multilevel B-spline free-form deformation, one-to-one whatever the features ask; hybrid: a coarse thin plate, then MFFD; auto (Morph node): the least-work warp of A onto B found from the pictures themselves, features acting as anchors.", Options::of(kind.methods, Method::name, Method::Field)),
+        PROGRESS.spec(
             "Progress",
             "t in [0, 1]: 0 shows A unchanged, 1 shows B (Morph) or A warped fully onto B's features (Warp). Ignored in the transition context, where the host's Transition param drives it.",
-            Kind::Double { default: 0.5, min: 0.0, max: 1.0, display: (0.0, 1.0) },
+            Doubles { default: 0.5, min: 0.0, max: 1.0, display: (0.0, 1.0) },
         ),
-        ParamSpec::new(USE_SCENE_PROGRESS, "Use Scene Progress", "When the scene keys progress, follow it instead of the Progress param.", Kind::Bool { default: true }),
-        ParamSpec::new(SETTINGS_FROM_SCENE, "Settings From Scene", "When a scene is loaded, its method and that method's settings (field, mesh, auto, thin plate, MFFD, and its transition when it has one) win over this node's.", Kind::Bool { default: true }),
-        ParamSpec::new("field_group", "Field", "Beier-Neely field constants", Kind::Group { open: true }),
-        ParamSpec::new(FIELD_A, "a", "weight = (length^p / (a + dist))^b. Barely above 0 pins pixels on a line to it; larger is smoother.", Kind::Double { default: d.a, min: 1e-6, max: 1000.0, display: (0.0001, 10.0) }).in_group("field_group"),
-        ParamSpec::new(FIELD_B, "b", "How fast a line's influence falls off with distance (0.5 to 2 is most useful).", Kind::Double { default: d.b, min: 0.0, max: 10.0, display: (0.0, 4.0) }).in_group("field_group"),
-        ParamSpec::new(FIELD_P, "p", "How much longer lines outweigh shorter ones (0: all equal, 1: by length).", Kind::Double { default: d.p, min: 0.0, max: 4.0, display: (0.0, 1.0) }).in_group("field_group"),
-        ParamSpec::new(INTERPOLATION, "Line Interpolation", "endpoints: endpoints move straight; center-angle: centre, angle and length interpolate (rotating lines keep their length).", choice(LineInterpolation::Endpoints)).in_group("field_group"),
-        ParamSpec::new(EVALUATION, "Evaluation", "adaptive: coarse grid refined where needed, within Tolerance of exact; exact: every pixel.", choice(EvaluationMode::Adaptive)).in_group("field_group"),
-        ParamSpec::new(TOLERANCE, "Tolerance", "Largest error of the adaptive evaluation, in pixels.", Kind::Double { default: Evaluation::DEFAULT_TOLERANCE, min: 0.001, max: 5.0, display: (0.01, 1.0) }).in_group("field_group").animated(false),
-        ParamSpec::new("mesh_group", "Mesh", "Mesh warp (the mesh comes from the scene's \"mesh\" key)", Kind::Group { open: false }),
-        ParamSpec::new(MESH_PASS, "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", choice(Pass::TwoPass)).in_group("mesh_group").animated(false),
-        ParamSpec::new("auto_group", "Auto", "Automatic correspondence by work minimisation (method auto)", Kind::Group { open: false }),
-        ParamSpec::new(AUTO_LEVELS, "Levels", "Depth of the search: 2^levels quads per side. 0: quads of about 4 pixels (6 at 256, 8 at HD). Fewer levels are faster and coarser.", Kind::Int { default: 0, min: 0, max: MAX_LEVEL as i32 }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_COLOUR, "Colour Work", "How hard the warp tries to match B's colours (the weight of re-colouring work).", Kind::Double { default: c.colour, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_STRETCH, "Stretch Work", "How much the warp resists stretching. 0 with Angle Work 0 gives a more fluid warp.", Kind::Double { default: c.stretch, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_ANGLE, "Angle Work", "How much the warp resists changing angles (shearing).", Kind::Double { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_ANCHORS, "Anchor Weight", "How strongly features (line slots, scene features) hold as anchor points.", Kind::Double { default: c.anchor, min: 0.0, max: 1000.0, display: (0.0, 100.0) }).in_group("auto_group").animated(false),
-        ParamSpec::new(AUTO_WARM_START, "Warm Start", "Start each frame from the previous frame's warp when the host renders in order: faster, but a frame then depends on where the sequence started, so a farm's chunks differ from one render at their first frames. Off (default): every frame is solved on its own, the same in any order and any chunking.", Kind::Bool { default: false }).in_group("auto_group").animated(false),
-        ParamSpec::new("scattered_group", "Thin Plate / MFFD", "Settings of the scattered-feature methods (thin-plate, mffd, hybrid)", Kind::Group { open: false }),
-        ParamSpec::new(PLATE_ALPHA, "Spring α", "How tightly the thin plate meets the feature points (px⁻²). Larger is tighter and slower to solve.", Kind::Double { default: tp.alpha, min: 0.01, max: 1e6, display: (1.0, 1000.0) }).in_group("scattered_group").animated(false),
-        ParamSpec::new(PLATE_BETA, "Glue β", "How soon a feature's pull dies away in the thin plate (px⁻⁴): it reaches about β^(-1/4) px. 0: no glue, the pull spreads over the frame.", Kind::Double { default: tp.beta, min: 0.0, max: 1.0, display: (0.0, 1e-4) }).in_group("scattered_group").animated(false),
-        ParamSpec::new(MFFD_ALPHA, "Refine α", "MFFD moves to a finer lattice when a step gains less than α (0.48 h)²: small values keep the deformation coarse and smooth.", Kind::Double { default: MffdSettings::default().alpha, min: 0.0, max: 1.0, display: (0.0, 1.0) }).in_group("scattered_group").animated(false),
-        ParamSpec::new("transition_group", "Transition", "How fast each part changes (transition curves come from the scene's \"transition\" key)", Kind::Group { open: false }),
-        ParamSpec::new(TRANSITION, "Transition", "uniform: every pixel at Progress; ramp, sine-rows, sine-columns, radial: each pixel's turn comes from where it is on A, every pixel still exactly A at 0 and B at 1.", choice_of(&PATTERNS, pattern_label, None)).in_group("transition_group"),
-        ParamSpec::new(TRANSITION_AFFECTS, "Affects", "What the transition paces: the geometry (where features are) and the colour (the dissolve), or one of them (the other stays uniform).", choice(Affects::Both)).in_group("transition_group").animated(false),
-        ParamSpec::new(TRANSITION_SPREAD, "Spread", "Share of the progress over which the pattern sweeps: 0 is uniform; near 1 each pixel changes almost at once, at its turn.", Kind::Double { default: 0.5, min: 0.0, max: 0.99, display: (0.0, 0.99) }).in_group("transition_group"),
-        ParamSpec::new(TRANSITION_ANGLE, "Angle", "Direction of the ramp in degrees: 0 left to right, 90 bottom to top.", Kind::Double { default: 0.0, min: -360.0, max: 360.0, display: (-180.0, 180.0) }).in_group("transition_group"),
-        ParamSpec::new(TRANSITION_CYCLES, "Cycles", "Sinusoid periods across the frame (sine patterns), or rings (radial; 0: the centre first, then outward).", Kind::Double { default: 2.0, min: 0.0, max: 100.0, display: (0.0, 8.0) }).in_group("transition_group"),
-        ParamSpec::new("lines_group", "Lines", "Line pairs keyframed in the host", Kind::Group { open: true }),
-        ParamSpec::new(LINE_COUNT, "Line Count", "How many of the line slots below are used.", Kind::Int { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group("lines_group").animated(false),
-        ParamSpec::new(SNAP_LINES, "Snap Lines", "Slides every enabled line, and every line, polyline and curve of Scene Text, onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved points there. Place features roughly, then press.", Kind::Button).in_group("lines_group"),
-        ParamSpec::new(SNAP_SIGMA, "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Kind::Double { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group("lines_group").animated(false),
-        ParamSpec::new(TRACK_FORWARD, "Track Forward", "Follows every enabled line, and every control point of Scene Text's shapes, through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", Kind::Button).in_group("lines_group"),
-        ParamSpec::new(TRACK_BACKWARD, "Track Backward", "As Track Forward, towards the start: to the previous key, or the first frame of the clip.", Kind::Button).in_group("lines_group"),
-        ParamSpec::new(OVERLAY_SHOW, "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", choice(Show::Both)).in_group("lines_group").animated(false),
-        ParamSpec::new(OVERLAY_EDIT, "Edit Lines", "Which features the pen moves in the viewer (line slots and the shapes of Scene Text). Drag a point, or a feature by its body. Hold Shift to grab only A's, Ctrl only B's.", choice(EditSides::Both)).in_group("lines_group").animated(false),
-        ParamSpec::new(DRAW_TOOL, "Draw", "What the pen draws in empty space. line: drag a line into the next slot. point: click to add a point to Scene Text. polyline, curve: click to add control points (click the first point to close the shape; click the last again, press Return or Finish Shape to end it open); with these tools a click on a shape's segment inserts a point. New shapes start with B on A: then move B's points.", choice(DrawTool::Line)).in_group("lines_group").animated(false),
-        ParamSpec::new(FINISH_SHAPE, "Finish Shape", "Ends the polyline or curve being drawn, open.", Kind::Button).in_group("lines_group"),
-        ParamSpec::new(DELETE_SHAPE, "Delete Shape", "Deletes the shape last drawn or grabbed in the viewer from Scene Text (Delete or Backspace over a point deletes that point).", Kind::Button).in_group("lines_group"),
-        ParamSpec::new(KEY_SHAPES, "Key Shapes Here", "Keys Scene Text's shapes at the current frame (a static scene becomes keyed); from then on an edit at a frame keys that frame.", Kind::Button).in_group("lines_group"),
-        ParamSpec::new(COPY_SCENE, "Copy Scene Into Node", "Copies Scene File's scene into Scene Text and empties Scene File, so its shapes can be edited in the viewer.", Kind::Button).in_group("lines_group"),
+        USE_SCENE_PROGRESS.spec( "Use Scene Progress", "When the scene keys progress, follow it instead of the Progress param.", true),
+        SETTINGS_FROM_SCENE.spec( "Settings From Scene", "When a scene is loaded, its method and that method's settings (field, mesh, auto, thin plate, MFFD, and its transition when it has one) win over this node's.", true),
+        FIELD_GROUP.spec( "Field", "Beier-Neely field constants", true),
+        FIELD_A.spec( "a", "weight = (length^p / (a + dist))^b. Barely above 0 pins pixels on a line to it; larger is smoother.", Doubles { default: d.a, min: 1e-6, max: 1000.0, display: (0.0001, 10.0) }).in_group(&FIELD_GROUP),
+        FIELD_B.spec( "b", "How fast a line's influence falls off with distance (0.5 to 2 is most useful).", Doubles { default: d.b, min: 0.0, max: 10.0, display: (0.0, 4.0) }).in_group(&FIELD_GROUP),
+        FIELD_P.spec( "p", "How much longer lines outweigh shorter ones (0: all equal, 1: by length).", Doubles { default: d.p, min: 0.0, max: 4.0, display: (0.0, 1.0) }).in_group(&FIELD_GROUP),
+        INTERPOLATION.spec( "Line Interpolation", "endpoints: endpoints move straight; center-angle: centre, angle and length interpolate (rotating lines keep their length).", LineInterpolation::Endpoints).in_group(&FIELD_GROUP),
+        EVALUATION.spec( "Evaluation", "adaptive: coarse grid refined where needed, within Tolerance of exact; exact: every pixel.", EvaluationMode::Adaptive).in_group(&FIELD_GROUP),
+        TOLERANCE.spec( "Tolerance", "Largest error of the adaptive evaluation, in pixels.", Doubles { default: Evaluation::DEFAULT_TOLERANCE, min: 0.001, max: 5.0, display: (0.01, 1.0) }).in_group(&FIELD_GROUP).animated(false),
+        MESH_GROUP.spec( "Mesh", "Mesh warp (the mesh comes from the scene's \"mesh\" key)", false),
+        MESH_PASS.spec( "Mesh Pass", "two-pass: rows then columns with Fant filtering (the classic algorithm, anti-aliased when squeezing); one-pass: bicubic patches inverted per pixel (no bottleneck under strong rotation, uses the Filter param).", Pass::TwoPass).in_group(&MESH_GROUP).animated(false),
+        AUTO_GROUP.spec( "Auto", "Automatic correspondence by work minimisation (method auto)", false),
+        AUTO_LEVELS.spec( "Levels", "Depth of the search: 2^levels quads per side. 0: quads of about 4 pixels (6 at 256, 8 at HD). Fewer levels are faster and coarser.", Ints { default: 0, min: 0, max: MAX_LEVEL as i32 }).in_group(&AUTO_GROUP).animated(false),
+        AUTO_COLOUR.spec( "Colour Work", "How hard the warp tries to match B's colours (the weight of re-colouring work).", Doubles { default: c.colour, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group(&AUTO_GROUP).animated(false),
+        AUTO_STRETCH.spec( "Stretch Work", "How much the warp resists stretching. 0 with Angle Work 0 gives a more fluid warp.", Doubles { default: c.stretch, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group(&AUTO_GROUP).animated(false),
+        AUTO_ANGLE.spec( "Angle Work", "How much the warp resists changing angles (shearing).", Doubles { default: c.angle, min: 0.0, max: 1000.0, display: (0.0, 10.0) }).in_group(&AUTO_GROUP).animated(false),
+        AUTO_ANCHORS.spec( "Anchor Weight", "How strongly features (line slots, scene features) hold as anchor points.", Doubles { default: c.anchor, min: 0.0, max: 1000.0, display: (0.0, 100.0) }).in_group(&AUTO_GROUP).animated(false),
+        AUTO_WARM_START.spec( "Warm Start", "Start each frame from the previous frame's warp when the host renders in order: faster, but a frame then depends on where the sequence started, so a farm's chunks differ from one render at their first frames. Off (default): every frame is solved on its own, the same in any order and any chunking.", false).in_group(&AUTO_GROUP).animated(false),
+        SCATTERED_GROUP.spec( "Thin Plate / MFFD", "Settings of the scattered-feature methods (thin-plate, mffd, hybrid)", false),
+        PLATE_ALPHA.spec( "Spring α", "How tightly the thin plate meets the feature points (px⁻²). Larger is tighter and slower to solve.", Doubles { default: tp.alpha, min: 0.01, max: 1e6, display: (1.0, 1000.0) }).in_group(&SCATTERED_GROUP).animated(false),
+        PLATE_BETA.spec( "Glue β", "How soon a feature's pull dies away in the thin plate (px⁻⁴): it reaches about β^(-1/4) px. 0: no glue, the pull spreads over the frame.", Doubles { default: tp.beta, min: 0.0, max: 1.0, display: (0.0, 1e-4) }).in_group(&SCATTERED_GROUP).animated(false),
+        MFFD_ALPHA.spec( "Refine α", "MFFD moves to a finer lattice when a step gains less than α (0.48 h)²: small values keep the deformation coarse and smooth.", Doubles { default: MffdSettings::default().alpha, min: 0.0, max: 1.0, display: (0.0, 1.0) }).in_group(&SCATTERED_GROUP).animated(false),
+        TRANSITION_GROUP.spec( "Transition", "How fast each part changes (transition curves come from the scene's \"transition\" key)", false),
+        TRANSITION.spec( "Transition", "uniform: every pixel at Progress; ramp, sine-rows, sine-columns, radial: each pixel's turn comes from where it is on A, every pixel still exactly A at 0 and B at 1.", Options::of(&PATTERNS, pattern_label, None)).in_group(&TRANSITION_GROUP),
+        TRANSITION_AFFECTS.spec( "Affects", "What the transition paces: the geometry (where features are) and the colour (the dissolve), or one of them (the other stays uniform).", Affects::Both).in_group(&TRANSITION_GROUP).animated(false),
+        TRANSITION_SPREAD.spec( "Spread", "Share of the progress over which the pattern sweeps: 0 is uniform; near 1 each pixel changes almost at once, at its turn.", Doubles { default: 0.5, min: 0.0, max: 0.99, display: (0.0, 0.99) }).in_group(&TRANSITION_GROUP),
+        TRANSITION_ANGLE.spec( "Angle", "Direction of the ramp in degrees: 0 left to right, 90 bottom to top.", Doubles { default: 0.0, min: -360.0, max: 360.0, display: (-180.0, 180.0) }).in_group(&TRANSITION_GROUP),
+        TRANSITION_CYCLES.spec( "Cycles", "Sinusoid periods across the frame (sine patterns), or rings (radial; 0: the centre first, then outward).", Doubles { default: 2.0, min: 0.0, max: 100.0, display: (0.0, 8.0) }).in_group(&TRANSITION_GROUP),
+        LINES_GROUP.spec( "Lines", "Line pairs keyframed in the host", true),
+        LINE_COUNT.spec( "Line Count", "How many of the line slots below are used.", Ints { default: 0, min: 0, max: LINE_SLOTS as i32 }).in_group(&LINES_GROUP).animated(false),
+        SNAP_LINES.spec( "Snap Lines", "Slides every enabled line, and every line, polyline and curve of Scene Text, onto the nearest strong edge of its source at the current frame (A positions on Source A, B positions on Source B) and keys the moved points there. Place features roughly, then press.", ()).in_group(&LINES_GROUP),
+        SNAP_SIGMA.spec( "Snap Reach", "Edge smoothing for Snap Lines, in pixels: edges pull lines from about twice this far.", Doubles { default: 3.0, min: 0.5, max: 50.0, display: (1.0, 10.0) }).in_group(&LINES_GROUP).animated(false),
+        TRACK_FORWARD.spec( "Track Forward", "Follows every enabled line, and every control point of Scene Text's shapes, through its source from the current frame to the line's next key (or the end of the clip) and keys it at each frame: A on Source A, B on Source B. Each frame is matched against the current frame's picture, so it does not drift; a line that loses track is left unkeyed from there and named. Cancel keeps the keys made so far.", ()).in_group(&LINES_GROUP),
+        TRACK_BACKWARD.spec( "Track Backward", "As Track Forward, towards the start: to the previous key, or the first frame of the clip.", ()).in_group(&LINES_GROUP),
+        OVERLAY_SHOW.spec( "Show Lines", "What the viewer draws: A's lines (one colour) and B's (another) with arrowheads, numbers and connectors, and the in-between lines dashed; or one of them; or nothing.", Show::Both).in_group(&LINES_GROUP).animated(false),
+        OVERLAY_EDIT.spec( "Edit Lines", "Which features the pen moves in the viewer (line slots and the shapes of Scene Text). Drag a point, or a feature by its body. Hold Shift to grab only A's, Ctrl only B's.", EditSides::Both).in_group(&LINES_GROUP).animated(false),
+        DRAW_TOOL.spec( "Draw", "What the pen draws in empty space. line: drag a line into the next slot. point: click to add a point to Scene Text. polyline, curve: click to add control points (click the first point to close the shape; click the last again, press Return or Finish Shape to end it open); with these tools a click on a shape's segment inserts a point. New shapes start with B on A: then move B's points.", DrawTool::Line).in_group(&LINES_GROUP).animated(false),
+        FINISH_SHAPE.spec( "Finish Shape", "Ends the polyline or curve being drawn, open.", ()).in_group(&LINES_GROUP),
+        DELETE_SHAPE.spec( "Delete Shape", "Deletes the shape last drawn or grabbed in the viewer from Scene Text (Delete or Backspace over a point deletes that point).", ()).in_group(&LINES_GROUP),
+        KEY_SHAPES.spec( "Key Shapes Here", "Keys Scene Text's shapes at the current frame (a static scene becomes keyed); from then on an edit at a frame keys that frame.", ()).in_group(&LINES_GROUP),
+        COPY_SCENE.spec( "Copy Scene Into Node", "Copies Scene File's scene into Scene Text and empties Scene File, so its shapes can be edited in the viewer.", ()).in_group(&LINES_GROUP),
     ];
     if !kind.has_auto() {
-        t.retain(|p| p.id != "auto_group" && p.group.as_deref() != Some("auto_group"));
+        t.retain(|p| p.id() != AUTO_GROUP.name() && p.group() != Some(AUTO_GROUP.name()));
     }
     for k in 1..=LINE_SLOTS {
         t.extend(slot_specs(k));
     }
     t.extend([
-        ParamSpec::new(
-            "scene_group",
+        SCENE_GROUP.spec(
             "Scene",
             "A MorphFX scene (.morph.json) with keyframed features, mesh and settings",
-            Kind::Group { open: false },
+            false,
         ),
-        ParamSpec::new(
-            SCENE_FILE,
+        SCENE_FILE.spec(
             "Scene File",
             "Path of a .morph.json scene; its features add to the line slots.",
-            Kind::Text {
+            Texts {
                 default: "",
                 mode: TextMode::FilePath,
             },
         )
-        .in_group("scene_group"),
-        ParamSpec::new(
-            SCENE_TEXT,
+        .in_group(&SCENE_GROUP),
+        SCENE_TEXT.spec(
             "Scene Text",
             "A scene as JSON text (used when Scene File is empty). The viewer draws its shapes and edits them in place.",
-            Kind::Text {
+            Texts {
                 default: "",
                 mode: TextMode::MultiLine,
             },
         )
-        .in_group("scene_group"),
-        ParamSpec::new(
-            OFFSET_A,
+        .in_group(&SCENE_GROUP),
+        OFFSET_A.spec(
             if kind.has_b() {
                 "Frame Offset A"
             } else {
                 "Frame Offset"
             },
             "Frames added to the time at which the source is read (sequence morphs).",
-            Kind::Int {
+            Ints {
                 default: 0,
                 min: -100000,
                 max: 100000,
@@ -171,49 +151,44 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
     ]);
     if kind.has_b() {
         t.push(
-            ParamSpec::new(
-                OFFSET_B,
-                "Frame Offset B",
-                "Frames added to the time at which Source B is read.",
-                Kind::Int {
-                    default: 0,
-                    min: -100000,
-                    max: 100000,
-                },
-            )
-            .animated(false),
+            OFFSET_B
+                .spec(
+                    "Frame Offset B",
+                    "Frames added to the time at which Source B is read.",
+                    Ints {
+                        default: 0,
+                        min: -100000,
+                        max: 100000,
+                    },
+                )
+                .animated(false),
         );
     }
     t.extend([
-        ParamSpec::new(
-            FILTER,
+        FILTER.spec(
             "Filter",
             "bilinear, or bicubic (Catmull-Rom: sharper, may overshoot).",
-            choice(Filter::Bilinear),
+            Filter::Bilinear,
         ),
-        ParamSpec::new(
-            EDGE,
+        EDGE.spec(
             "Edge",
             "Outside the source: clamp to the edge pixels, black (transparent), or mirror.",
-            choice(EdgeMode::Clamp),
+            EdgeMode::Clamp,
         ),
-        ParamSpec::new(
-            VIEW,
+        VIEW.spec(
             "View",
             "What the node outputs. ghost: where the warped sources still disagree (alpha the mean |A - B| over R, G, B; colour a heat ramp, black where they agree): double edges to fix. folds: where a warp folds the image over itself (alpha 1 there, the morph tinted magenta beneath).",
-            choice_of(kind.views, |v| kind.view_label(v), kind.views[0]),
+            Options::of(kind.views, |v| kind.view_label(v), kind.views[0]),
         ),
-        ParamSpec::new(
-            MASK_INVERT,
+        MASK_INVERT.spec(
             "Invert Mask",
             "Use 1 - the Mask input's alpha: the effect applies where the mask is clear.",
-            Kind::Bool { default: false },
+            false,
         ),
-        ParamSpec::new(
-            MIX,
+        MIX.spec(
             "Mix",
             "How much of the effect reaches the output: 0 shows the source unchanged (Source A on the Morph node), 1 the full effect. Multiplies the Mask input's alpha where one is connected.",
-            Kind::Double { default: 1.0, min: 0.0, max: 1.0, display: (0.0, 1.0) },
+            Doubles { default: 1.0, min: 0.0, max: 1.0, display: (0.0, 1.0) },
         ),
     ]);
     t
@@ -231,20 +206,12 @@ pub(super) fn slot_specs(k: usize) -> Vec<ParamSpec> {
     // host without the overlay do not all start on top of each other.
     let y = 100.0 + 40.0 * ((k - 1) % 16) as f64;
     let mut specs = vec![
-        ParamSpec::new(
-            group.clone(),
-            format!("Line {k}"),
-            format!("Line pair {k}"),
-            Kind::Group { open: false },
-        )
-        .in_group("lines_group"),
-        ParamSpec::new(
-            enable,
-            "Enabled",
-            format!("Use line pair {k}."),
-            Kind::Bool { default: true },
-        )
-        .in_group(group.clone()),
+        group
+            .spec(format!("Line {k}"), format!("Line pair {k}"), false)
+            .in_group(&LINES_GROUP),
+        enable
+            .spec("Enabled", format!("Use line pair {k}."), true)
+            .in_group(&group),
     ];
     for (id, label, x) in [
         (a0, "A Start", 100.0),
@@ -252,25 +219,12 @@ pub(super) fn slot_specs(k: usize) -> Vec<ParamSpec> {
         (b0, "B Start", 100.0),
         (b1, "B End", 300.0),
     ] {
-        specs.push(
-            ParamSpec::new(
-                id,
-                format!("Line {k} {label}"),
-                format!("Line {k}: {label} (canonical pixels, y up)."),
-                Kind::Point { default: (x, y) },
-            )
-            .in_group(group.clone()),
-        );
+        let hint = format!("Line {k}: {label} (canonical pixels, y up).");
+        let row = id.spec(format!("Line {k} {label}"), hint, (x, y));
+        specs.push(row.in_group(&group));
     }
-    specs.push(
-        ParamSpec::new(
-            slot_clear(k),
-            "Clear Line",
-            format!("Removes line {k}'s keys, puts it back where it started and turns it off."),
-            Kind::Button,
-        )
-        .in_group(group),
-    );
+    let hint = format!("Removes line {k}'s keys, puts it back where it started and turns it off.");
+    specs.push(slot_clear(k).spec("Clear Line", hint, ()).in_group(&group));
     specs
 }
 
@@ -287,12 +241,7 @@ pub fn spec(kind: &'static NodeKind, id: &str) -> Option<&'static ParamSpec> {
 pub fn table_in_context(kind: &'static NodeKind, context: Context) -> Vec<ParamSpec> {
     let mut table = table(kind).to_vec();
     if context == Context::Transition {
-        table.push(ParamSpec::new(
-            TRANSITION_PARAM,
-            "",
-            "",
-            Kind::HostDriven { default: 0.0 },
-        ));
+        table.push(TRANSITION_PARAM.host_driven(0.0));
     }
     table
 }

@@ -89,8 +89,8 @@ fn released() -> Vec<(&'static NodeKind, &'static str, &'static [&'static str])>
 fn options(kind: &'static NodeKind, id: &str) -> Option<(Vec<&'static str>, usize)> {
     table(kind)
         .iter()
-        .find(|p| p.id == id)
-        .map(|p| match &p.kind {
+        .find(|p| p.id() == id)
+        .map(|p| match p.kind() {
             Kind::Choice { options, default } => (options.clone(), *default),
             other => panic!("{id} is not a choice: {other:?}"),
         })
@@ -113,14 +113,16 @@ fn every_choice_param_is_recorded_with_a_default_among_its_options() {
     let recorded = released();
     for kind in [MORPH, WARP] {
         for p in table(kind) {
-            if let Kind::Choice { options, default } = &p.kind {
+            if let Kind::Choice { options, default } = p.kind() {
                 assert!(
-                    recorded.iter().any(|(k, id, _)| *k == kind && *id == p.id),
+                    recorded
+                        .iter()
+                        .any(|(k, id, _)| *k == kind && *id == p.id()),
                     "{} {}: record its options in RELEASED",
                     kind.label,
-                    p.id
+                    p.id()
                 );
-                assert!(*default < options.len(), "{} {}", kind.label, p.id);
+                assert!(*default < options.len(), "{} {}", kind.label, p.id());
             }
         }
     }
@@ -162,14 +164,18 @@ fn ids_are_unique_and_hints_speak_to_compositors() {
     for kind in [MORPH, WARP] {
         let t = table(kind);
         for (i, p) in t.iter().enumerate() {
-            assert!(t[i + 1..].iter().all(|q| q.id != p.id), "{} twice", p.id);
+            assert!(
+                t[i + 1..].iter().all(|q| q.id() != p.id()),
+                "{} twice",
+                p.id()
+            );
             for stale in ["not yet", "seed", "CONTRACT", "§"] {
                 assert!(
-                    !p.label.contains(stale) && !p.hint.contains(stale),
+                    !p.label().contains(stale) && !p.hint().contains(stale),
                     "{}: {stale:?} in {:?} / {:?}",
-                    p.id,
-                    p.label,
-                    p.hint
+                    p.id(),
+                    p.label(),
+                    p.hint()
                 );
             }
         }
