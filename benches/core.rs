@@ -1,5 +1,6 @@
 //! Core engine benchmarks: the field map at 1080p, resampling, a whole morph
-//! frame, the mesh warp (two-pass and one-pass), triangles, snakes and `auto`. Numbers and the machine go in docs/PERFORMANCE.md.
+//! frame, the mesh warp (two-pass and one-pass), triangles, snakes and
+//! `auto`. Numbers and the machine go in docs/PERFORMANCE.md.
 //!
 //! `cargo bench --features bench --bench core` (add `-- field` etc. to pick a group).
 

@@ -104,7 +104,8 @@ fn check_size(
 ) -> std::result::Result<(), HostError> {
     if w.saturating_mul(h) > MAX_PIXELS {
         return Err(HostError::bad(format!(
-            "{}: its {what} is {w}x{h} pixels, over morphfx's limit of {MAX_PIXELS} pixels (16384x16384) a plate",
+            "{}: its {what} is {w}x{h} pixels, over morphfx's limit of \
+                {MAX_PIXELS} pixels (16384x16384) a plate",
             path.display()
         )));
     }
@@ -257,7 +258,9 @@ fn read_exr_meta(path: &Path) -> std::result::Result<exr::meta::MetaData, HostEr
     let table_end = counted.read.saturating_add(chunks.saturating_mul(8));
     let cut = |what: String| {
         HostError::bad(format!(
-            "{}: cannot read EXR: the file ends before its header or pixels do: it is truncated ({what}; the file has {length} bytes)",
+            "{}: cannot read EXR: the file ends before its header or \
+                pixels do: it is truncated ({what}; the file has {length} \
+                bytes)",
             path.display()
         ))
     };

@@ -111,7 +111,8 @@ impl Scored {
         let (median, p90, worst) = (percentile(&e, 0.5), percentile(&e, 0.9), e[e.len() - 1]);
         let flagged = self.errors.iter().filter(|(_, f)| *f).count();
         eprintln!(
-            "{what}: {} positions: median {median:.3} px, 90 % {p90:.3} px, worst {worst:.3} px, {flagged} flagged",
+            "{what}: {} positions: median {median:.3} px, 90 % {p90:.3} \
+                px, worst {worst:.3} px, {flagged} flagged",
             e.len()
         );
         (median, p90, worst)

@@ -590,7 +590,8 @@ impl Params {
         }
         if !self.blocks_refused.swap(true, Ordering::AcqRel) {
             eprintln!(
-                "MorphFX: the host answered paramEditBegin with {}; edits are made without undo blocks",
+                "MorphFX: the host answered paramEditBegin with {}; edits are \
+                    made without undo blocks",
                 super::status_name(status)
             );
         }

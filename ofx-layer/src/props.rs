@@ -24,7 +24,8 @@ fn cstring(v: &str) -> CString {
 
 macro_rules! call {
     ($self:ident, $f:ident, $name:expr, $($arg:expr),*) => {{
-        let f = $self.suite.$f.ok_or_else(|| Failure::Failed(concat!("host has no ", stringify!($f)).into()))?;
+        let missing = || Failure::Failed(concat!("host has no ", stringify!($f)).into());
+        let f = $self.suite.$f.ok_or_else(missing)?;
         // SAFETY: `handle` came from the host for this action and is non-null
         // (checked in `new`); names are NUL-terminated; out-pointers point at
         // live locals of the right type.

@@ -540,7 +540,8 @@ mod tests {
                                 for c in 0..channels {
                                     assert!(
                                         (got[c] - want[c]).abs() <= 1e-5 * (1.0 + want[c].abs()),
-                                        "{channels} ch {filter:?} {edge:?} premult {premultiplied} at {p:?}: {got:?} vs {want:?}"
+                                        "{channels} ch {filter:?} {edge:?} premult {premultiplied} at \
+                                            {p:?}: {got:?} vs {want:?}"
                                     );
                                 }
                             }

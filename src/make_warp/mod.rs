@@ -81,7 +81,9 @@ pub fn toward(
             Method::Auto => {
                 let c = settings.correspondence.as_ref().ok_or_else(|| {
                     Error::Invalid(
-                        "method \"auto\" needs both images: its correspondence is solved from A and B (the Morph node, morphfx morph)".into(),
+                        "method \"auto\" needs both images: its correspondence is \
+                            solved from A and B (the Morph node, morphfx morph)"
+                            .into(),
                     )
                 })?;
                 Ok(Arc::new(c.toward(side, tween)))

@@ -34,7 +34,8 @@ impl WarpSettings {
                 })?;
                 if !(f.width() <= MAX_FEATURE_SPAN && f.height() <= MAX_FEATURE_SPAN) {
                     return Err(Error::Invalid(format!(
-                        "method \"{}\": the features span {:.3e} x {:.3e} px, more than {MAX_FEATURE_SPAN} px",
+                        "method \"{}\": the features span {:.3e} x {:.3e} px, more \
+                            than {MAX_FEATURE_SPAN} px",
                         self.method().name(),
                         f.width(),
                         f.height()
@@ -59,7 +60,9 @@ impl WarpSettings {
                         .map(|n| format!(" \"{n}\""))
                         .unwrap_or_default();
                     return Err(Error::Invalid(format!(
-                        "feature {}{name}: its {side} point ({}, {}) lies more than {REACH}× the frame's width outside the frame ({}, {}) - ({}, {}); method \"{}\" cannot reach it",
+                        "feature {}{name}: its {side} point ({}, {}) lies more than \
+                            {REACH}× the frame's width outside the frame ({}, {}) - ({}, \
+                            {}); method \"{}\" cannot reach it",
                         i + 1,
                         p.x,
                         p.y,

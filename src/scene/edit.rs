@@ -466,7 +466,8 @@ fn on_span(f: &Feature, side: Side, span: usize, s: f64) -> Result<Vec2> {
     let spans = if f.closed { n } else { n.saturating_sub(1) };
     if span >= spans || !matches!(f.kind, FeatureKind::Polyline | FeatureKind::Curve) {
         return Err(Error::Invalid(format!(
-            "a point can be inserted only into a span of a polyline or curve (span {span} of {spans})"
+            "a point can be inserted only into a span of a polyline or \
+                curve (span {span} of {spans})"
         )));
     }
     Ok(match (f.kind, f.closed) {

@@ -149,7 +149,8 @@ impl Scene {
         if method == Method::Mesh && meshes.is_empty() {
             return Err(Error::scene(
                 "mesh",
-                "method \"mesh\" needs a mesh: {\"rows\": R, \"cols\": C, \"a\": [...], \"b\": [...]}",
+                "method \"mesh\" needs a mesh: {\"rows\": R, \"cols\": C, \
+                    \"a\": [...], \"b\": [...]}",
             ));
         }
         let auto = match raw.auto {
@@ -392,7 +393,8 @@ fn mesh(raw: RawMesh) -> Result<(MeshSettings, Vec<(f64, MeshPair)>)> {
         _ => {
             return Err(Error::scene(
                 "mesh",
-                "needs node positions: \"a\" and \"b\" (rows × cols points each, bottom row first), or \"keyframes\"",
+                "needs node positions: \"a\" and \"b\" (rows × cols points \
+                    each, bottom row first), or \"keyframes\"",
             ))
         }
     }
@@ -482,7 +484,8 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
                 return Err(Error::scene(
                     &at,
                     format!(
-                        "{side}[{}] repeats {side}[0]: a closed shape returns to its first point by itself",
+                        "{side}[{}] repeats {side}[0]: a closed shape returns to its \
+                            first point by itself",
                         pts.len() - 1
                     ),
                 ));
@@ -536,7 +539,8 @@ fn same_feature_list(first: &Keyframe, features: &[Feature], at: &str) -> Result
         return Err(Error::scene(
             at,
             format!(
-                "has {} features but keyframe at frame {} has {}; every keyframe must hold the same features",
+                "has {} features but keyframe at frame {} has {}; every \
+                    keyframe must hold the same features",
                 features.len(),
                 first.frame,
                 reference.len()
@@ -548,7 +552,9 @@ fn same_feature_list(first: &Keyframe, features: &[Feature], at: &str) -> Result
             return Err(Error::scene(
                 format!("{at} {}", f.label(i)),
                 format!(
-                    "differs from {} of frame {} ({} with {} points vs {} with {}); every keyframe must hold the same features in the same order",
+                    "differs from {} of frame {} ({} with {} points vs {} with \
+                        {}); every keyframe must hold the same features in the same \
+                        order",
                     r.label(i),
                     first.frame,
                     f.kind.name(),

@@ -182,7 +182,8 @@ fn main() {
         Some("test") => test(&args[1..]),
         _ => {
             eprintln!(
-                "usage: cargo xtask bundle [--release] | demo [-o DIR] | test [cargo test args] | refhost | farm"
+                "usage: cargo xtask bundle [--release] | demo [-o DIR] | test \
+                    [cargo test args] | refhost | farm"
             );
             exit(2);
         }

@@ -145,7 +145,8 @@ pub fn compare_with_oiiotool(plates: &Path, frames: usize, morph_secs: f64) {
         Ok(s) if s.success() => {
             let secs = started.elapsed().as_secs_f64();
             eprintln!(
-                "oiiotool copies sequence A ({frames} frames) in {secs:.2} s: the morph took {:.2}x that",
+                "oiiotool copies sequence A ({frames} frames) in {secs:.2} s: \
+                    the morph took {:.2}x that",
                 morph_secs / secs.max(1e-9)
             );
             if let Ok(ours) = copy_sequence(plates, &copy, frames) {

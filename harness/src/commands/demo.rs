@@ -122,7 +122,8 @@ pub fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
 const SHOWS: [(&str, &str); 4] = [
     (
         "field",
-        "Beier-Neely line pairs: the eyes ringed, the mouth outlined, the face's outline ray by ray",
+        "Beier-Neely line pairs: the eyes ringed, the mouth outlined, \
+            the face's outline ray by ray",
     ),
     (
         "mesh",
@@ -343,7 +344,10 @@ pub fn demo_report(bundle_path: &Path, dir: &Path, ghosts: &[(&str, (f64, f64))]
         "  ghost:    {} and each method's ghost.####.exr (where the warped plates still disagree)",
         dir.join("ghost.####.exr").display(),
     );
-    println!("what each method shows, and its ghost at frame 6 (mean; share of pixels above 0.1, where edges double):");
+    println!(
+        "what each method shows, and its ghost at frame 6 (mean; \
+        share of pixels above 0.1, where edges double):"
+    );
     for (name, (ghost, bright)) in ghosts {
         let shows = SHOWS.iter().find(|(n, _)| n == name).map_or("", |(_, s)| s);
         println!("  {name:<9} {ghost:.3}; {:>4.1}%  {shows}", 100.0 * bright);

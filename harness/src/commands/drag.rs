@@ -93,7 +93,8 @@ pub fn drag(
     inst.clip_preferences()?;
     let mut step = 0.0;
     eprintln!(
-        "drag: one of {LINES} lines moved a pixel before each render, {}x{} RGBA float, field method (adaptive), median of {moves}",
+        "drag: one of {LINES} lines moved a pixel before each render, \
+            {}x{} RGBA float, field method (adaptive), median of {moves}",
         size.0, size.1
     );
     for scale in [1.0, 0.5] {
@@ -123,7 +124,8 @@ pub fn drag(
         }
         let (m, s) = (median(moved), median(still));
         eprintln!(
-            "  render scale {scale}: {m:.1} ms after a move; {s:.1} ms with nothing moved (the morph frame alone, cached warps): {:.2}x",
+            "render scale {scale}: {m:.1} ms after a move; {s:.1} ms with \
+                nothing moved (the morph frame alone, cached warps): {:.2}x",
             m / s.max(1e-9)
         );
     }

@@ -567,7 +567,8 @@ pub fn check_inputs(plates: &[(String, Arc<Plates>)], frames: &[i64]) -> Result<
                 None => first = Some((s, name)),
                 Some((s0, n0)) if *s0 != s => {
                     return Err(HostError::bad(format!(
-                        "size mismatch: the display window of {name} is {}x{} but that of {n0} is {}x{}",
+                        "size mismatch: the display window of {name} is {}x{} but \
+                            that of {n0} is {}x{}",
                         s.0, s.1, s0.0, s0.1
                     )))
                 }

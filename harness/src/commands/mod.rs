@@ -44,5 +44,10 @@ pub fn find_bundle(given: Option<&Path>, plugin_path: &str) -> Result<PathBuf, H
     candidates
         .into_iter()
         .find(|c| crate::host::bundle_binary(c).is_file())
-        .ok_or_else(|| HostError::bad("no MorphFX bundle found: pass --bundle, set OFX_PLUGIN_PATH, or build one with `cargo xtask bundle`"))
+        .ok_or_else(|| {
+            HostError::bad(
+                "no MorphFX bundle found: pass --bundle, set OFX_PLUGIN_PATH, \
+            or build one with `cargo xtask bundle`",
+            )
+        })
 }

@@ -116,7 +116,8 @@ impl Snap<'_> {
             .map_err(|e| HostError::failed(format!("refined scene is invalid: {e}")))?;
         io::write_text(self.output, &out)?;
         println!(
-            "snap: refined {refined} polyline/curve feature(s) on both images (largest move {moved:.2} px) -> {}",
+            "snap: refined {refined} polyline/curve feature(s) on both \
+                images (largest move {moved:.2} px) -> {}",
             self.output.display()
         );
         Ok(())

@@ -229,7 +229,8 @@ unsafe extern "C" fn get_string(
     out: *mut *mut c_char,
 ) -> OfxStatus {
     super::guard::guard(kOfxStatErrUnknown, "get_string", || {
-        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks
+        // the handle, the name and the out-pointer before use.
         unsafe { get_any(h, n, i, out as *mut c_void, b's') }
     })
 }
@@ -240,7 +241,8 @@ unsafe extern "C" fn get_int(
     out: *mut c_int,
 ) -> OfxStatus {
     super::guard::guard(kOfxStatErrUnknown, "get_int", || {
-        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks
+        // the handle, the name and the out-pointer before use.
         unsafe { get_any(h, n, i, out as *mut c_void, b'i') }
     })
 }
@@ -251,7 +253,8 @@ unsafe extern "C" fn get_double(
     out: *mut f64,
 ) -> OfxStatus {
     super::guard::guard(kOfxStatErrUnknown, "get_double", || {
-        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks
+        // the handle, the name and the out-pointer before use.
         unsafe { get_any(h, n, i, out as *mut c_void, b'd') }
     })
 }
@@ -262,7 +265,8 @@ unsafe extern "C" fn get_pointer(
     out: *mut *mut c_void,
 ) -> OfxStatus {
     super::guard::guard(kOfxStatErrUnknown, "get_pointer", || {
-        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks the handle, the name and the out-pointer before use.
+        // SAFETY: the plugin's own arguments, forwarded; `get_any` checks
+        // the handle, the name and the out-pointer before use.
         unsafe { get_any(h, n, i, out as *mut c_void, b'p') }
     })
 }

@@ -16,7 +16,9 @@ impl Node for Morph {
     const KIND: &'static NodeKind = &NodeKind {
         id: c"net.morphfx.Morph",
         label: "MorphFX Morph",
-        description: "Feature-based morph (Beier-Neely field warping): warps A and B toward the in-between feature positions and dissolves them.",
+        description: "Feature-based morph (Beier-Neely field warping): warps A and \
+            B toward the in-between feature positions and dissolves \
+            them.",
         contexts: &[Context::General, Context::Transition],
         sources: Sources::Two {
             general: ["SourceA", "SourceB"],

@@ -14,7 +14,8 @@ impl Node for Warp {
     const KIND: &'static NodeKind = &NodeKind {
         id: c"net.morphfx.Warp",
         label: "MorphFX Warp",
-        description: "Warps one image so its features (A positions) move toward their B positions by progress t.",
+        description: "Warps one image so its features (A positions) move toward \
+            their B positions by progress t.",
         contexts: &[Context::Filter, Context::General],
         sources: Sources::One("Source"),
         timing_matte: false,

@@ -68,7 +68,8 @@ impl Grid {
         let g = Grid { level, pts };
         if let Some((j, k)) = g.first_folded_quad() {
             return Err(Error::Invalid(format!(
-                "the quad of columns {j}..{} and rows {k}..{} is not convex and counter-clockwise (the warp would fold)",
+                "the quad of columns {j}..{} and rows {k}..{} is not convex \
+                    and counter-clockwise (the warp would fold)",
                 j + 1,
                 k + 1
             )));

@@ -282,7 +282,10 @@ proptest! {
         let d = a1 - a0;
         let b0 = a0 + v(mx, my);
         let b1 = b0 + v(d.x * rot.cos() - d.y * rot.sin(), d.x * rot.sin() + d.y * rot.cos());
-        let other = Feature::line([v(ox, oy), v(ox + 30.0, oy + 5.0)], [v(ox + 3.0, oy), v(ox + 33.0, oy + 8.0)]);
+        let other = Feature::line(
+            [v(ox, oy), v(ox + 30.0, oy + 5.0)],
+            [v(ox + 3.0, oy), v(ox + 33.0, oy + 8.0)],
+        );
         let f = Feature::line([a0, a1], [b0, b1]);
         let s = FieldSettings { a: 1e-4, ..exact(1e-4) };
         let w = FieldWarp::toward(&[f, other], Side::A, 1.0, &s);

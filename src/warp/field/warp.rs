@@ -67,7 +67,8 @@ impl FieldWarp {
             let v = (x - p).dot(d.perp()) / d.length(); // (2)
             let ds = qs - ps;
             let xs = ps + ds * u + ds.perp() * (v / ds.length()); // (3)
-                                                                  // Distance to the directed segment (footnote to §3.3).
+
+            // Distance to the directed segment (footnote to §3.3).
             let dist = if u < 0.0 {
                 (x - p).length()
             } else if u > 1.0 {

@@ -131,7 +131,8 @@ impl Mesh {
                 let p = self.node(r, c);
                 if r > 0 && p.y <= self.node(r - 1, c).y {
                     return bad(format!(
-                        "column {c} does not rise monotonically: node (row {r}, col {c}) at y = {} is not above node (row {}, col {c}) at y = {}",
+                        "column {c} does not rise monotonically: node (row {r}, col \
+                            {c}) at y = {} is not above node (row {}, col {c}) at y = {}",
                         p.y,
                         r - 1,
                         self.node(r - 1, c).y
@@ -139,7 +140,9 @@ impl Mesh {
                 }
                 if c > 0 && p.x <= self.node(r, c - 1).x {
                     return bad(format!(
-                        "row {r} does not run monotonically to the right: node (row {r}, col {c}) at x = {} is not right of node (row {r}, col {}) at x = {}",
+                        "row {r} does not run monotonically to the right: node (row \
+                            {r}, col {c}) at x = {} is not right of node (row {r}, col \
+                            {}) at x = {}",
                         p.x,
                         c - 1,
                         self.node(r, c - 1).x
@@ -162,7 +165,8 @@ impl Mesh {
                 });
                 if folded {
                     return bad(format!(
-                        "cell (row {r}, col {c}) is folded or self-intersecting (its corners do not run counter-clockwise around a convex quad)"
+                        "cell (row {r}, col {c}) is folded or self-intersecting (its \
+                            corners do not run counter-clockwise around a convex quad)"
                     ));
                 }
             }
@@ -230,7 +234,8 @@ impl MeshPair {
                 let border = r == 0 || c == 0 || r + 1 == a.rows || c + 1 == a.cols;
                 if border && a.node(r, c) != b.node(r, c) {
                     return Err(Error::Invalid(format!(
-                        "mesh: border node (row {r}, col {c}) is at {:?} in a but {:?} in b; the border rows and columns must stay frozen",
+                        "mesh: border node (row {r}, col {c}) is at {:?} in a but \
+                            {:?} in b; the border rows and columns must stay frozen",
                         <[f64; 2]>::from(a.node(r, c)),
                         <[f64; 2]>::from(b.node(r, c))
                     )));

@@ -177,7 +177,8 @@ impl Track<'_> {
         let (first, last) = (self.frames[0], self.frames[self.frames.len() - 1]);
         if self.frames.windows(2).any(|w| w[1] != w[0] + 1) {
             return Err(HostError::bad(format!(
-                "--frames: track needs one unbroken range FIRST-LAST, not a list ({} frames from {first} to {last})",
+                "--frames: track needs one unbroken range FIRST-LAST, not a \
+                    list ({} frames from {first} to {last})",
                 self.frames.len()
             )));
         }
@@ -327,7 +328,8 @@ fn check_present(pattern: &str, first: i64, last: i64) -> Result<(), HostError> 
             .collect()
     } else {
         return Err(HostError::bad(format!(
-            "{pattern}: track follows features through a sequence: give a #-numbered pattern such as plate.####.exr"
+            "{pattern}: track follows features through a sequence: give a \
+                #-numbered pattern such as plate.####.exr"
         )));
     };
     match missing.as_slice() {
@@ -377,7 +379,9 @@ fn summarise(
                 );
             } else {
                 eprintln!(
-                    "feature {}{name} ({}), {side}: LOST TRACK at frames {} (marked \"lost\" in the scene; key it there), mean confidence {mean:.3}",
+                    "feature {}{name} ({}), {side}: LOST TRACK at frames {} \
+                        (marked \"lost\" in the scene; key it there), mean \
+                        confidence {mean:.3}",
                     i + 1,
                     kind.name(),
                     ranges(&lost)

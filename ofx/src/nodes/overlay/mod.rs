@@ -85,7 +85,8 @@ pub fn delete_shape(instance: &NodeState, effect: &EffectHandle, time: f64) -> O
     let Some(feature) = selected else {
         effect.warning(
             c"net.morphfx.overlay.select",
-            "Delete Shape: grab a shape in the viewer first (the last one drawn or grabbed is deleted)",
+            "Delete Shape: grab a shape in the viewer first (the last one \
+                drawn or grabbed is deleted)",
         );
         return Ok(());
     };

@@ -20,7 +20,9 @@ pub fn document(instance: &NodeState, time: f64) -> Outcome<Document> {
     let r = Reader::new(instance.params(), instance.kind, time);
     if !r.text(&SCENE_FILE).trim().is_empty() {
         return Err(Failure::BadInput(
-            "Scene File is in use, so its shapes are read-only: press Copy Scene Into Node to edit them".into(),
+            "Scene File is in use, so its shapes are read-only: press \
+                Copy Scene Into Node to edit them"
+                .into(),
         ));
     }
     Document::parse(&r.text(&SCENE_TEXT)).map_err(|e| {
