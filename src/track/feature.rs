@@ -2,15 +2,15 @@
 //!
 //! Points, polylines and curves: each control point is tracked on its own.
 //! A line's ends follow their own matches where those can be trusted (a
-//! corner, matched well): a motion that bends along the line moves each
-//! end its own way. Elsewhere the line is tracked along its whole
-//! length: patches spaced along it are tracked, and one affine motion is
-//! fitted to all of them, each patch weighted by how firmly its texture fixes each direction (a patch on the
-//! line's edge fixes only the across-edge position; one on a corner fixes
-//! both) and pulled towards its own local affine motion; the line's ends
-//! move by that motion. A line is then carried by the picture along it, not
-//! by the two pixels under its ends, which often lie where there is little
-//! to see.
+//! corner, matched well): a motion that bends along the line moves each end
+//! its own way. Elsewhere the line is tracked along its whole length:
+//! patches spaced along it are tracked, and one affine motion is fitted to
+//! all of them, each patch weighted by how firmly its texture fixes each
+//! direction (a patch on the line's edge fixes only the across-edge
+//! position; one on a corner fixes both) and pulled towards its own local
+//! affine motion; the line's ends move by that motion. A line is then
+//! carried by the picture along it, not by the two pixels under its ends,
+//! which often lie where there is little to see.
 
 use crate::features::FeatureKind;
 use crate::geom::Vec2;
