@@ -4,7 +4,9 @@
 //! cache and the copies; this says what they cost.
 //!
 //! The overlay: 60 shapes of 20 points each in Scene Text drawn through
-//! the Draw suite, hovered and dragged, against parsing the same text.
+//! the Draw suite, hovered and dragged, against parsing the same text;
+//! and 100 lines (all 64 line slots, 36 more in Scene Text), hovered and
+//! a slot's line dragged, with the host reads each event makes printed.
 //!
 //! `cargo xtask bundle --release && cargo bench -p morphfx-harness --features bench --bench plugin`
 
@@ -218,5 +220,84 @@ fn bench_overlay(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_plugin_path, bench_overlay);
+criterion_group!(
+    benches,
+    bench_plugin_path,
+    bench_overlay,
+    bench_overlay_lines
+);
+
+/// Host value calls (reads and writes) the instance's params have had.
+fn value_calls(inst: &morphfx_harness::host::Instance<'_>) -> usize {
+    let names = inst.param_names();
+    names.iter().map(|(name, _)| inst.value_calls(name)).sum()
+}
+
+/// A 100-line node: the 64 line slots and 36 lines in Scene Text.
+fn bench_overlay_lines(c: &mut Criterion) {
+    let lines = lines();
+    let (slots, text) = lines.split_at(64);
+    let options = HostOptions {
+        overlays: true,
+        draw_suite: true,
+    };
+    let bundle = Bundle::load_with(&bundle_path(), options).expect("the bundle");
+    let inst = bundle
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    inst.set_project(W as f64, H as f64);
+    inst.set_int("line_count", 64).unwrap();
+    for (k, f) in slots.iter().enumerate() {
+        for (side, which) in [(Side::A, "a"), (Side::B, "b")] {
+            let [p, q] = [f.points(side)[0], f.points(side)[1]];
+            let name = |end: &str| format!("line{}_{which}_{end}", k + 1);
+            inst.set_double(&name("start"), &[p.x, p.y], None).unwrap();
+            inst.set_double(&name("end"), &[q.x, q.y], None).unwrap();
+        }
+    }
+    inst.set_string("scene_text", &scene_json(text)).unwrap();
+    let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
+    let mut g = c.benchmark_group("overlay_100_lines");
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    let (before, n) = (value_calls(&inst), 50);
+    for k in 0..n {
+        let at = (100.0 + k as f64, 540.0);
+        ov.pen(kOfxInteractActionPenMotion, 1.0, at, (1.0, 1.0))
+            .unwrap();
+    }
+    let per_hover = (value_calls(&inst) - before) / n;
+    let before = value_calls(&inst);
+    ov.draw(1.0, (1.0, 1.0)).unwrap();
+    let per_draw = value_calls(&inst) - before;
+    eprintln!("overlay_100_lines: {per_hover} param value calls per hover, {per_draw} per draw");
+    g.bench_function("draw", |bch| {
+        bch.iter(|| black_box(ov.draw(1.0, (1.0, 1.0)).unwrap()))
+    });
+    g.bench_function("hover_motion", |bch| {
+        bch.iter(|| {
+            ov.pen(kOfxInteractActionPenMotion, 1.0, (960.0, 540.0), (1.0, 1.0))
+                .unwrap()
+        })
+    });
+    // A drag of slot 1's A start: each motion keys the point, then the
+    // viewer redraws.
+    let p = slots[0].points(Side::A)[0];
+    let start = (p.x, p.y);
+    ov.pen(kOfxInteractActionPenDown, 1.0, start, (1.0, 1.0))
+        .unwrap();
+    let mut k = 0.0;
+    g.bench_function("drag_motion_and_redraw", |bch| {
+        bch.iter(|| {
+            k += 0.01;
+            let at = (start.0 + k, start.1);
+            ov.pen(kOfxInteractActionPenMotion, 1.0, at, (1.0, 1.0))
+                .unwrap();
+            black_box(ov.draw(1.0, (1.0, 1.0)).unwrap())
+        })
+    });
+    ov.pen(kOfxInteractActionPenUp, 1.0, start, (1.0, 1.0))
+        .unwrap();
+    g.finish();
+}
+
 criterion_main!(benches);

@@ -354,3 +354,72 @@ fn morphfx_overlay_draws_the_lines_over_the_plate_and_refuses_bad_options() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--show c"));
     assert!(!dir.join("x.exr").exists());
 }
+
+/// Param value calls of the instance so far, by param.
+fn value_calls(inst: &Instance<'_>) -> std::collections::HashMap<String, usize> {
+    let names = inst.param_names().into_iter().map(|(name, _)| name);
+    names.map(|n| (n.clone(), inst.value_calls(&n))).collect()
+}
+
+/// The params read between two counts, with how often.
+fn read_between(
+    before: &std::collections::HashMap<String, usize>,
+    after: &std::collections::HashMap<String, usize>,
+) -> std::collections::BTreeMap<String, usize> {
+    let calls = after.iter().map(|(n, &k)| (n.clone(), k - before[n]));
+    calls.filter(|(_, k)| *k > 0).collect()
+}
+
+/// A pen hover reads only what places the features it can grab: the
+/// used slots (each param once), Line Count, the scene's two params and
+/// the edit sides; a draw adds what the in-between shapes need. Neither
+/// reads a render setting, nor a slot past Line Count.
+#[test]
+fn hover_and_draw_read_only_what_the_overlay_shows() {
+    let inst = morph();
+    inst.set_int("line_count", 40).unwrap();
+    for k in 1..=40 {
+        let y = 10.0 * k as f64;
+        for which in ["a", "b"] {
+            inst.set_double(&format!("line{k}_{which}_start"), &[10.0, y], None)
+                .unwrap();
+            inst.set_double(&format!("line{k}_{which}_end"), &[90.0, y], None)
+                .unwrap();
+        }
+    }
+    let ov = overlay(&inst);
+    let before = value_calls(&inst);
+    ov.pen(kOfxInteractActionPenMotion, 0.0, (500.0, 500.0), (1.0, 1.0))
+        .unwrap();
+    let hover = read_between(&before, &value_calls(&inst));
+    let mut wanted: Vec<String> = ["line_count", "scene_file", "scene_text"]
+        .into_iter()
+        .chain(["overlay_edit", "overlay_show"])
+        .map(String::from)
+        .collect();
+    for k in 1..=40 {
+        for p in ["enable", "a_start", "a_end", "b_start", "b_end"] {
+            wanted.push(format!("line{k}_{p}"));
+        }
+    }
+    let extra: Vec<_> = hover.keys().filter(|n| !wanted.contains(n)).collect();
+    let unread: Vec<_> = wanted.iter().filter(|n| !hover.contains_key(*n)).collect();
+    assert!(extra.is_empty(), "a hover reads {extra:?} too");
+    assert!(unread.is_empty(), "a hover does not read {unread:?}");
+    assert!(hover.values().all(|&k| k == 1), "each once: {hover:?}");
+    assert_eq!(hover.values().sum::<usize>(), 205);
+
+    let before = value_calls(&inst);
+    ov.draw(0.0, (1.0, 1.0)).unwrap();
+    let draw = read_between(&before, &value_calls(&inst));
+    for render_only in ["mix", "filter", "edge", "view", "method", "line41_enable"] {
+        assert!(
+            !draw.contains_key(render_only),
+            "a draw reads {render_only}"
+        );
+    }
+    for shown in ["progress", "field_a", "line_interpolation", "line40_b_end"] {
+        assert!(draw.contains_key(shown), "a draw needs {shown}");
+    }
+    assert!(draw.values().all(|&k| k == 1), "each once: {draw:?}");
+}

@@ -46,7 +46,7 @@ impl Document {
     /// numbers kept on one line each.
     pub fn text(&self) -> String {
         let mut out = String::new();
-        write_value(&mut out, &Value::Object(self.root.clone()), 0);
+        write_object(&mut out, &self.root, 0);
         out.push('\n');
         out
     }
@@ -247,9 +247,7 @@ impl Document {
             scene: &self.scene,
         };
         change(&mut editor)?;
-        let text = serde_json::to_string(&editor.root)
-            .map_err(|e| Error::Invalid(format!("scene text: {e}")))?;
-        let scene = Scene::read(&text)?;
+        let scene = Scene::from_json(Value::Object(editor.root.clone()))?;
         self.root = editor.root;
         self.scene = scene;
         Ok(())
@@ -517,18 +515,7 @@ fn number(x: f64) -> Value {
 fn write_value(out: &mut String, v: &Value, indent: usize) {
     let pad = |n: usize| "  ".repeat(n);
     match v {
-        Value::Object(o) if !o.is_empty() => {
-            out.push_str("{\n");
-            for (i, (k, v)) in o.iter().enumerate() {
-                out.push_str(&pad(indent + 1));
-                out.push_str(&Value::String(k.clone()).to_string());
-                out.push_str(": ");
-                write_value(out, v, indent + 1);
-                out.push_str(if i + 1 < o.len() { ",\n" } else { "\n" });
-            }
-            out.push_str(&pad(indent));
-            out.push('}');
-        }
+        Value::Object(o) if !o.is_empty() => write_object(out, o, indent),
         Value::Array(items) if !items.is_empty() && !items.iter().all(is_flat) => {
             out.push_str("[\n");
             for (i, v) in items.iter().enumerate() {
@@ -541,6 +528,25 @@ fn write_value(out: &mut String, v: &Value, indent: usize) {
         }
         other => write_inline(out, other),
     }
+}
+
+/// A non-empty object, one key per line (an empty one is `{}`).
+fn write_object(out: &mut String, o: &Map<String, Value>, indent: usize) {
+    if o.is_empty() {
+        out.push_str("{}");
+        return;
+    }
+    let pad = |n: usize| "  ".repeat(n);
+    out.push_str("{\n");
+    for (i, (k, v)) in o.iter().enumerate() {
+        out.push_str(&pad(indent + 1));
+        out.push_str(&Value::String(k.clone()).to_string());
+        out.push_str(": ");
+        write_value(out, v, indent + 1);
+        out.push_str(if i + 1 < o.len() { ",\n" } else { "\n" });
+    }
+    out.push_str(&pad(indent));
+    out.push('}');
 }
 
 /// A scalar or a nest of arrays of scalars, on one line: `[[1, 2], [3, 4]]`.

@@ -193,3 +193,33 @@ fn deleting_a_feature_keeps_transition_curves_on_theirs() {
         (Some(1), Some(0))
     );
 }
+
+/// After every kind of edit, the scene a document holds is the scene its
+/// text reads as: a node hands the edited scene on with the text it
+/// writes, so nothing reads the text again.
+#[test]
+fn a_documents_scene_is_what_its_text_reads_as_after_every_edit() {
+    let same = |d: &Document| {
+        let read = super::Scene::read(&d.text()).expect("the text reads");
+        assert_eq!(*d.scene(), read);
+    };
+    for text in [STATIC, KEYED, ""] {
+        let mut d = Document::parse(text).unwrap();
+        same(&d);
+        let f = d
+            .add_feature(&Feature::point(Vec2::new(1.5, 2.0), Vec2::new(3.0, 4.25)))
+            .unwrap();
+        same(&d);
+        d.set_point(15.0, f, Side::B, 0, Vec2::new(7.125, 8.0))
+            .unwrap();
+        same(&d);
+        let from = [Vec2::new(1.5, 2.0)];
+        d.move_feature(15.0, f, Side::A, &from, Vec2::new(0.5, -1.0))
+            .unwrap();
+        same(&d);
+        d.key_here(12.0).unwrap();
+        same(&d);
+        d.delete_feature(f).unwrap();
+        same(&d);
+    }
+}

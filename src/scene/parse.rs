@@ -134,6 +134,18 @@ impl Scene {
                 e.to_string(),
             )
         })?;
+        Scene::from_raw(raw)
+    }
+
+    /// [`Scene::read`] of a document already parsed as JSON (an edited
+    /// one): the same checks, with no text written or read.
+    pub fn from_json(value: serde_json::Value) -> Result<Scene> {
+        let raw: RawScene =
+            serde_json::from_value(value).map_err(|e| Error::scene("scene", e.to_string()))?;
+        Scene::from_raw(raw)
+    }
+
+    fn from_raw(raw: RawScene) -> Result<Scene> {
         check_header(&raw)?;
         let method = method(raw.method.as_deref())?;
         let field = match raw.field {

@@ -227,3 +227,70 @@ impl<N: Node> Overlay<Effect<N>> for FeatureOverlay {
         overlay::lose_focus(node.state())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use morphfx::make_warp::Method;
+    use morphfx::views::View;
+    use ofx_layer::params::Params;
+    use ofx_layer::plugin::{Context, ImageEffect};
+
+    use super::{Effect, Node};
+    use crate::nodes::kind::{NodeKind, Sources};
+    use crate::nodes::params::METHOD;
+
+    /// A third node, made as docs/architecture.md says: a marker type and
+    /// its kind, nothing else.
+    struct Blend;
+
+    impl Node for Blend {
+        const KIND: &'static NodeKind = &NodeKind {
+            id: c"net.morphfx.test.Blend",
+            label: "Blend",
+            description: "A third node of Morph's engine, in a test.",
+            contexts: &[Context::General],
+            sources: Sources::Two {
+                general: ["First", "Second"],
+                transition: ["From", "To"],
+            },
+            timing_matte: false,
+            methods: &[Method::Field, Method::Triangles],
+            views: &[View::Morph, View::Ghost],
+            view_labels: &[(View::Ghost, "differences")],
+        };
+    }
+
+    #[test]
+    fn a_third_node_is_described_from_its_kind_alone() {
+        let spec = Effect::<Blend>::describe_in_context(Context::General);
+        let clips: Vec<&str> = spec.clips.iter().map(|c| c.name).collect();
+        assert_eq!(clips, ["First", "Second", "Mask", "Output"]);
+        let choice = |id: &str| {
+            let p = spec.params.iter().find(|p| p.id() == id).expect(id);
+            match p.kind() {
+                ofx_layer::spec::Kind::Choice { options, .. } => options.clone(),
+                other => panic!("{id} is {other:?}"),
+            }
+        };
+        assert_eq!(choice(METHOD.name()), ["field", "triangles"]);
+        assert_eq!(choice("view"), ["morph", "differences"]);
+        // No auto method, so none of its params; two sources, so both
+        // frame offsets.
+        assert!(spec.params.iter().all(|p| !p.id().starts_with("auto_")));
+        assert!(spec.params.iter().any(|p| p.id() == "frame_offset_b"));
+        assert_eq!(<Effect<Blend> as ImageEffect>::LABEL, "Blend");
+        assert!(<Effect<Blend> as ImageEffect>::OVERLAY.is_some());
+        let made = Effect::<Blend>::create_unbound(Context::General);
+        assert!(made.state().kind.has_b());
+    }
+
+    impl<N: Node> Effect<N> {
+        /// An instance over params bound to no host.
+        fn create_unbound(context: Context) -> Self {
+            Effect {
+                state: crate::nodes::state::NodeState::create(N::KIND, context, Params::unbound()),
+                node: std::marker::PhantomData,
+            }
+        }
+    }
+}

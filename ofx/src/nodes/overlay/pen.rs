@@ -11,7 +11,7 @@ use super::hit;
 
 use super::shapes::{self, refused};
 use super::state::{editable, pixel_of, Building, Drag, Handle, Owner, Part};
-use super::view::view;
+use super::view::outlines;
 use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
 use crate::nodes::params::{OVERLAY_EDIT, OVERLAY_SHOW};
@@ -36,7 +36,7 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
     let (handle, sides) = {
         let state = instance.overlay.locked();
         let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
-        let outlines = view(instance, pen.time).outlines;
+        let outlines = outlines(instance, &r, pen.time);
         let handle = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
         (handle.map(|h| (h, outlines)), sides)
     };
@@ -259,7 +259,7 @@ pub fn motion(
     let r = Reader::new(instance.params(), instance.kind, pen.time);
     let mut state = instance.overlay.locked();
     let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
-    let outlines = view(instance, pen.time).outlines;
+    let outlines = outlines(instance, &r, pen.time);
     let hover = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
     // While a shape is drawn, every motion moves its rubber band.
     let building = match state.building.as_mut() {

@@ -4,6 +4,7 @@
 
 use morphfx::scene::edit::Document;
 
+use crate::nodes::inputs::remember_scene_text;
 use crate::nodes::params::{Reader, SCENE_FILE, SCENE_TEXT};
 use crate::nodes::state::NodeState;
 use ofx_layer::clips::EffectHandle;
@@ -34,7 +35,10 @@ pub fn document(instance: &NodeState, time: f64) -> Outcome<Document> {
 
 /// Writes `doc` into Scene Text.
 pub fn write(instance: &NodeState, doc: &Document) -> Outcome {
-    instance.params().set_string(&SCENE_TEXT, &doc.text())
+    let text = doc.text();
+    instance.params().set_string(&SCENE_TEXT, &text)?;
+    remember_scene_text(instance, &text, doc.scene().clone());
+    Ok(())
 }
 
 /// Shows why an edit was refused on the node until the next edit that

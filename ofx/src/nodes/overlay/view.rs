@@ -1,66 +1,89 @@
 //! What the overlay shows at a time, and drawing it.
 
+use std::sync::Arc;
+
 use morphfx::geom::Vec2;
+use morphfx::scene::Scene;
+use morphfx::warp::field::FieldSettings;
 
 use super::outline::{self, Outline};
 use super::paint::{self, Frame};
 use super::state::Owner;
-use crate::nodes::inputs::{load_scene, warp_inputs};
+use crate::nodes::inputs::{load_scene, progress_at, scene_settings};
 use crate::nodes::lines::slot_lines;
-use crate::nodes::params::{Reader, Settings, Show, OVERLAY_SHOW};
+use crate::nodes::params::{
+    field_settings, Reader, Show, OVERLAY_SHOW, PROGRESS, SCENE_FILE, SCENE_TEXT,
+    SETTINGS_FROM_SCENE, USE_SCENE_PROGRESS,
+};
 use crate::nodes::state::NodeState;
 use ofx_layer::paint::Painter;
 use ofx_layer::plugin::DrawArgs;
 use ofx_layer::sync::Locked;
-use ofx_layer::Outcome;
-use ofx_layer::Reply;
+use ofx_layer::{Outcome, Reply};
 
-/// Every feature of the node at `time`, with the progress and the frames
-/// Scene Text's shapes are keyed at. A scene that does not parse is drawn
-/// as nothing (the slots still are).
-pub(super) struct View {
-    pub(super) outlines: Vec<Outline>,
-    t: f64,
-    keys: Vec<f64>,
-    settings: Settings,
+/// What the pen can grab at `time`: every line slot and every feature of
+/// the scene, at their A and B positions. It reads only the params that
+/// place them (Scene File, Scene Text, Line Count and the used slots). A
+/// scene that does not parse gives no features (the slots still count).
+pub(super) fn outlines(instance: &NodeState, r: &Reader<'_>, time: f64) -> Vec<Outline> {
+    outlines_and_scene(instance, r, time).0
 }
 
-pub(super) fn view(instance: &NodeState, time: f64) -> View {
-    let settings = Settings::read(instance.params(), time, instance.kind);
-    let slots = slot_lines(&Reader::new(instance.params(), instance.kind, time));
-    let from_file = !settings.scene_file.trim().is_empty();
-    let mut outlines = Vec::new();
-    let mut t = settings.progress;
-    if let Ok(inputs) = warp_inputs(instance, &settings, time) {
-        let n = inputs.features.len() - settings.lines.len();
-        let owner = |i| {
-            if from_file {
-                Owner::File(i)
-            } else {
-                Owner::Shape(i)
-            }
-        };
-        outlines.extend(
-            inputs.features[..n]
-                .iter()
-                .enumerate()
-                .map(|(i, f)| Outline {
-                    owner: owner(i),
-                    feature: f.clone(),
-                }),
-        );
-        t = inputs.t;
-    }
-    let keys = match load_scene(instance, &settings) {
-        Ok(Some(scene)) if !from_file => scene.keyframes.iter().map(|k| k.frame).collect(),
+/// The outlines, and the scene they came from with whether it is Scene
+/// File's.
+fn outlines_and_scene(
+    instance: &NodeState,
+    r: &Reader<'_>,
+    time: f64,
+) -> (Vec<Outline>, Option<(Arc<Scene>, bool)>) {
+    let (file, text) = (r.text(&SCENE_FILE), r.text(&SCENE_TEXT));
+    let from_file = !file.trim().is_empty();
+    let scene = load_scene(instance, &file, &text).ok().flatten();
+    let owner = |i| match from_file {
+        true => Owner::File(i),
+        false => Owner::Shape(i),
+    };
+    let scene_features = scene
+        .as_ref()
+        .map_or_else(Vec::new, |s| s.features_at(time));
+    let mut outlines: Vec<Outline> = scene_features
+        .into_iter()
+        .enumerate()
+        .map(|(i, feature)| Outline {
+            owner: owner(i),
+            feature,
+        })
+        .collect();
+    outlines.extend(slot_lines(r).iter().map(Outline::slot));
+    (outlines, scene.map(|s| (s, from_file)))
+}
+
+/// What the overlay draws at `time`: the outlines, the progress their
+/// in-between shapes are drawn at, the line interpolation those follow,
+/// and the frames Scene Text's shapes are keyed at.
+struct View {
+    outlines: Vec<Outline>,
+    t: f64,
+    field: FieldSettings,
+    keys: Vec<f64>,
+}
+
+fn view(instance: &NodeState, r: &Reader<'_>, time: f64) -> View {
+    let (outlines, scene) = outlines_and_scene(instance, r, time);
+    let loaded = scene.as_ref().map(|(s, _)| &**s);
+    let node = (r.double(&PROGRESS), r.bool(&USE_SCENE_PROGRESS));
+    let t = progress_at(instance, loaded, node, time).unwrap_or(node.0);
+    let from_scene = scene_settings(loaded, r.bool(&SETTINGS_FROM_SCENE), time);
+    let field = from_scene.map_or_else(|| field_settings(r), |w| w.settings.field);
+    let keys = match &scene {
+        Some((s, false)) => s.keyframes.iter().map(|k| k.frame).collect(),
         _ => Vec::new(),
     };
-    outlines.extend(slots.iter().map(Outline::slot));
     View {
         outlines,
         t,
+        field,
         keys,
-        settings,
     }
 }
 
@@ -72,12 +95,13 @@ pub fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) ->
     if args.measured {
         instance.overlay.locked().measured_pixel = Some(pixel);
     }
-    let show: Show = Reader::new(instance.params(), kind, time).choice(&OVERLAY_SHOW);
+    let r = Reader::new(instance.params(), kind, time);
+    let show: Show = r.choice(&OVERLAY_SHOW);
     if show == Show::Off {
         return Ok(Reply::Done);
     }
-    let v = view(instance, time);
-    let field = &v.settings.warp.field;
+    let v = view(instance, &r, time);
+    let field = &v.field;
     let between: Vec<Vec<Vec2>> = v
         .outlines
         .iter()

@@ -120,7 +120,7 @@ impl Settings {
     }
 }
 
-pub(super) fn field_settings(r: &Reader<'_>) -> FieldSettings {
+pub fn field_settings(r: &Reader<'_>) -> FieldSettings {
     let evaluation = match r.choice(&EVALUATION) {
         EvaluationMode::Exact => Evaluation::Exact,
         EvaluationMode::Adaptive => Evaluation::Adaptive {
