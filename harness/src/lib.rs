@@ -1,6 +1,7 @@
 //! `morphfx`, the standalone harness: an OpenFX host for the MorphFX bundle
 //! (reached only through its C ABI), EXR/PNG/JPEG/TIFF frame IO, sequences.
 
+pub mod args;
 pub mod cli;
 pub mod commands;
 pub mod error;
@@ -8,8 +9,10 @@ pub mod exr_zip;
 pub mod host;
 pub mod interrupt;
 pub mod io;
+pub mod locate;
 pub mod pipeline;
 pub mod plate;
+pub mod plates;
 pub mod progress;
 pub mod raster;
 pub mod sequence;

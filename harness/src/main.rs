@@ -6,11 +6,10 @@ use clap::Parser;
 use morphfx::snake::SnakeSettings;
 use morphfx_harness::cli::{Cli, Command, JobKind};
 use morphfx_harness::commands::snap::Snap;
-use morphfx_harness::commands::{
-    bench, demo, drag, find_bundle, job, openjd, overlay, params, plugins, track,
-};
+use morphfx_harness::commands::{bench, demo, job, openjd, overlay, params, plugins, track};
 use morphfx_harness::host::{ErrorKind, HostError};
 use morphfx_harness::interrupt;
+use morphfx_harness::locate::find_bundle;
 
 fn main() {
     morphfx_harness::host::allocator::tune_for_frames();
@@ -118,7 +117,7 @@ fn run(cli: Cli) -> Result<(), HostError> {
             height,
             moves,
             ..
-        } => drag::drag(&bundle_path()?, (width, height), moves),
+        } => bench::drag::drag(&bundle_path()?, (width, height), moves),
         Command::Bench {
             output,
             frames,

@@ -7,14 +7,14 @@ use std::time::{Duration, Instant};
 
 use morphfx::scene::Scene;
 
-use super::line_key::LineKey;
-use super::param_value::ParamSetting;
-use super::plates::Plates;
+use crate::args::line_key::LineKey;
+use crate::args::param_value::ParamSetting;
 use crate::cli::Common;
 use crate::host::{Bundle, HostError, Instance, OutputSpec};
 use crate::interrupt;
 use crate::io::{self, ExrPrecision, Plate};
 use crate::pipeline::WriteBehind;
+use crate::plates::Plates;
 use crate::progress::Progress;
 use crate::sequence::{frame_path, is_sequence, parse_frames};
 use crate::sync::Locked;

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::job::{MORPH_ID, WARP_ID};
-use super::param_value::param_lines;
+use crate::args::param_value::param_lines;
 use crate::host::{Bundle, HostError};
 
 /// Lists the params of `node` (`morph`, `warp`, or both when `None`), in

@@ -1,6 +1,8 @@
 //! `morphfx bench`: a generated shot morphed and timed as a user runs it,
 //! beside OpenImageIO copying the same plates.
 
+pub mod drag;
+
 use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::Instant;
@@ -8,8 +10,8 @@ use std::time::Instant;
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 
-use super::job::{Job, MORPH_ID};
 use crate::cli::Common;
+use crate::commands::job::{Job, MORPH_ID};
 use crate::host::HostError;
 use crate::io::{self, ExrPrecision, Plate};
 use crate::sequence::frame_path;

@@ -9,7 +9,7 @@ use std::time::Instant;
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 
-use super::job::MORPH_ID;
+use crate::commands::job::MORPH_ID;
 use crate::host::{Bundle, Frame, FrameSource, HostError, OutputSpec};
 
 /// Lines in the scene: a face's worth and more.
