@@ -42,6 +42,33 @@ impl EffectHandle {
         })
     }
 
+    /// A handle to no effect, with suites that have no functions: what an
+    /// effect's default actions are tested with (they touch no host).
+    #[cfg(test)]
+    pub(crate) fn unbound() -> EffectHandle {
+        use openfx::sys::generic::property::OfxPropertySuiteV1;
+        // SAFETY: each suite is a struct of `Option`s of function pointers,
+        // for which all-zero bytes are `None`.
+        static PROP: OfxPropertySuiteV1 = unsafe { std::mem::zeroed() };
+        // SAFETY: as above.
+        static EFFECT: OfxImageEffectSuiteV1 = unsafe { std::mem::zeroed() };
+        // SAFETY: as above.
+        static PARAM: OfxParameterSuiteV1 = unsafe { std::mem::zeroed() };
+        EffectHandle {
+            handle: std::ptr::null_mut(),
+            suites: Suites {
+                prop: &PROP,
+                effect: &EFFECT,
+                param: &PARAM,
+                message: None,
+                message_v2: None,
+                interact: None,
+                draw: None,
+                progress: None,
+            },
+        }
+    }
+
     pub(super) fn props(&self) -> Outcome<PropSet> {
         let f = self
             .suites

@@ -337,3 +337,78 @@ impl<E> OverlayActions<E> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An effect that states what it is and renders, and nothing more.
+    struct Minimal;
+
+    impl ImageEffect for Minimal {
+        const ID: &'static CStr = c"test.Minimal";
+        const VERSION: (u32, u32) = (1, 0);
+        const LABEL: &'static str = "Minimal";
+        const DESCRIPTION: &'static str = "Renders; the host does the rest.";
+        const GROUPING: &'static str = "Test";
+        const CONTEXTS: &'static [Context] = &[Context::Filter];
+        const CAPABILITIES: Capabilities = Capabilities {
+            depths: &[PixelDepth::Float],
+            thread_safety: ThreadSafety::FullySafe,
+            host_frame_threading: true,
+            tiles: true,
+            multi_resolution: true,
+            temporal_access: false,
+            multiple_clip_depths: false,
+            multiple_clip_aspects: false,
+            sequential: Sequential::No,
+        };
+        fn describe_in_context(_: Context) -> ContextSpec {
+            ContextSpec {
+                clips: Vec::new(),
+                params: Vec::new(),
+            }
+        }
+        fn create(_: &EffectHandle, _: Context, _: Params) -> Outcome<Self> {
+            Ok(Minimal)
+        }
+        fn render(&self, _: &EffectHandle, _: &RenderArgs) -> Outcome {
+            Ok(())
+        }
+    }
+
+    /// Describe, create and render are all an effect must write: it has no
+    /// overlay, and every other action is left to the host.
+    #[test]
+    fn an_effect_needs_only_describe_create_and_render() {
+        assert!(Minimal::OVERLAY.is_none());
+        let (effect, time) = (EffectHandle::unbound(), 1.0);
+        let args = RenderArgs {
+            time,
+            window: RectI::default(),
+            sequential: false,
+            interactive: false,
+        };
+        let m = Minimal;
+        assert_eq!(m.region_of_definition(&effect, time), Ok(None));
+        let mut rois = Rois::default();
+        assert_eq!(
+            m.regions_of_interest(&effect, time, &mut rois),
+            Ok(Reply::Default)
+        );
+        assert!(rois.set.is_empty());
+        let mut frames = FramesNeeded::default();
+        assert_eq!(
+            m.frames_needed(&effect, time, &mut frames),
+            Ok(Reply::Default)
+        );
+        let mut prefs = ClipPreferences::default();
+        assert_eq!(m.clip_preferences(&effect, &mut prefs), Ok(Reply::Default));
+        assert_eq!(m.is_identity(&effect, &args), Ok(None));
+        let change = ParamChange {
+            name: "x".into(),
+            time,
+        };
+        assert_eq!(m.param_changed(&effect, &change), Ok(()));
+    }
+}
