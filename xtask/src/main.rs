@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{exit, Command};
+use std::time::Instant;
 
 mod farm;
 mod refhost;
@@ -86,18 +87,20 @@ fn run_cargo(mut c: Command) {
     }
 }
 
-/// The core's and the plugin's unit tests again as x86-64-v3 code, which is what the
+/// The core's unit tests again as x86-64-v3 code, which is what the
 /// bundle's fast build runs: with FMA the resampling kernels take paths
 /// (two bilinear pixels per vector) that baseline code leaves out, and
-/// their bit-exactness tests must see them. Skipped on a CPU without AVX2
-/// and FMA, which could not run that code.
+/// their bit-exactness tests must see them. Only the core: its kernels are
+/// what the CPU level changes, and a v3 build of the plugin's own tests
+/// would compile the OpenFX layer and its bindings once more for nothing.
+/// Skipped on a CPU without AVX2 and FMA, which could not run that code.
 fn core_tests_fast() {
     if !cpu_runs_fast_build() {
         println!("core tests as x86-64-v3 code: skipped, this CPU lacks AVX2 or FMA");
         return;
     }
     let (mut c, _) = fast_cargo();
-    c.arg("test").args(FAST_TEST_SELECTION);
+    c.args(["test", "--package", "morphfx", "--lib", "--features", "testing"]);
     run_cargo(c);
 }
 
@@ -193,22 +196,33 @@ fn main() {
 /// The README's test command: every test, then the checks against tools
 /// and hosts we did not write.
 fn test(cargo_args: &[String]) {
-    let b = build_for_tests();
+    let started = Instant::now();
+    let b = timed("build", build_for_tests);
     // Tests find the bundle through this variable.
     unsafe_env("MORPHFX_BUNDLE", &b);
-    let mut skipped = ensure_tools();
+    let mut skipped = timed("tools", ensure_tools);
     let mut run = vec!["test", "--workspace"];
     run.extend(cargo_args.iter().map(String::as_str));
-    cargo(&run);
-    core_tests_fast();
-    release_concurrency(&b);
-    docs();
-    skipped.extend(refhost::check(&b));
+    timed("cargo test", || cargo(&run));
+    timed("core tests as x86-64-v3 code", core_tests_fast);
+    timed("release concurrency", || release_concurrency(&b));
+    timed("cargo doc", docs);
+    skipped.extend(timed("reference host", || refhost::check(&b)));
     let morphfx = dev_morphfx();
-    skipped.extend(farm::check(&morphfx, &b));
-    cmake_install_check(&morphfx);
-    morphfx_install_check(&b);
+    skipped.extend(timed("farm", || farm::check(&morphfx, &b)));
+    timed("cmake install", || cmake_install_check(&morphfx));
+    timed("cargo install", || morphfx_install_check(&b));
     summary(&skipped);
+    let s = started.elapsed().as_secs();
+    println!("xtask test: {} min {} s in all", s / 60, s % 60);
+}
+
+/// Runs `step`, then says how long it took: where a run's time goes.
+fn timed<T>(what: &str, step: impl FnOnce() -> T) -> T {
+    let started = Instant::now();
+    let out = step();
+    println!("xtask test: {what}: {:.0} s", started.elapsed().as_secs_f64());
+    out
 }
 
 /// The outside tools tests run, installed where this machine can; each
@@ -279,39 +293,22 @@ fn skips_fail(skipped: &[String], ci: bool, can_apt: bool) -> bool {
     !skipped.is_empty() && ci && can_apt
 }
 
-/// Builds what the tests run, each in one cargo call per CPU level, and
-/// lays out the dev bundle. One call per level matters for time: cargo
-/// unifies features over the packages and targets of a call, and the test
-/// targets' dev-dependencies (the core's `testing`, criterion's serde) change
-/// them, so building the plugin alone and then the tests compiled the core,
-/// the plugin and the `morphfx` binary twice (a fifth of a cold run). The
-/// test binaries, the `morphfx` binary the farm check runs and the plugin
-/// in the bundle are the very artefacts `cargo test` then reuses.
+/// Builds what the tests run and lays out the dev bundle: the workspace's
+/// test build (one cargo call: cargo unifies features over the packages
+/// and targets of a call, and the test targets' dev-dependencies change
+/// them, so building the plugin alone and then the tests compiled the
+/// core, the plugin and the `morphfx` binary twice), and beside its plugin
+/// the release x86-64-v3 build, which CPUs with AVX2 and FMA hand over to.
+/// That release build is the one users' hosts run on such CPUs, and the
+/// same artefact the CMake install check and the release concurrency check
+/// use: the plugin is compiled three times in a cold run (v3 release,
+/// baseline dev, baseline release for CMake), not four.
 fn build_for_tests() -> PathBuf {
-    let fast = cfg!(target_arch = "x86_64").then(|| {
-        let (mut c, dir) = fast_cargo();
-        c.args(["build"]).args(FAST_TEST_SELECTION);
-        run_cargo(c);
-        plugin_binary(&dir, "debug")
-    });
+    let fast = cfg!(target_arch = "x86_64").then(|| build_plugin(true, true));
     cargo(&["build", "--workspace", "--lib", "--bins", "--tests"]);
     let baseline = plugin_binary(&target_dir(), "debug");
     lay_out("bundle", &baseline, fast.as_deref())
 }
-
-/// The x86-64-v3 build's packages, targets and features: the same for its
-/// build (which also leaves the plugin binary) and its test run, so the
-/// second compiles nothing.
-const FAST_TEST_SELECTION: &[&str] = &[
-    "--package",
-    "morphfx",
-    "--package",
-    "morphfx-ofx",
-    "--lib",
-    "--tests",
-    "--features",
-    "morphfx/testing",
-];
 
 /// The `morphfx` binary of the dev profile, built if need be.
 fn morphfx_binary() -> PathBuf {
@@ -331,14 +328,22 @@ fn dev_morphfx() -> PathBuf {
     target_dir().join("debug").join("morphfx")
 }
 
-/// The concurrency test again on the plugin built in the release profile:
+/// The concurrency test on the plugin built in the release profile:
 /// optimised code reorders and inlines more, and has no overflow checks, so
-/// races and arithmetic a debug build hides show here. The build is the
-/// one this CPU runs (the x86-64-v3 build where the CPU has AVX2 and FMA,
-/// as the bundle's hand-over picks), so only it is compiled; the host side,
-/// the dev test binary already built, only drives it.
+/// races and arithmetic a debug build hides show here. Where this CPU runs
+/// the bundle's x86-64-v3 build, the dev bundle already hands over to its
+/// release build and the test run's concurrency test ran on it; elsewhere
+/// the baseline release build is made (the one the CMake check reuses) and
+/// the test is run again on it.
 fn release_concurrency(dev_bundle: &Path) {
-    let plugin = build_plugin(true, cpu_runs_fast_build());
+    if cpu_runs_fast_build() {
+        println!(
+            "release concurrency: ran in the test run (this CPU runs the bundle's release \
+             x86-64-v3 build)"
+        );
+        return;
+    }
+    let plugin = build_plugin(true, false);
     let b = lay_out("bundle-release", &plugin, None);
     unsafe_env("MORPHFX_BUNDLE", &b);
     // `--workspace`, as the test build: the same features, nothing rebuilt.
