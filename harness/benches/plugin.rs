@@ -187,6 +187,24 @@ fn bench_overlay(c: &mut Criterion) {
     inst.set_project(W as f64, H as f64);
     inst.set_string("scene_text", &text).unwrap();
     let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
+    // A drag of one control point: each motion edits and writes Scene
+    // Text, then the viewer redraws.
+    let start = {
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let p = &v["features"][0]["a"][0];
+        (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
+    };
+    draw_hover_and_drag(&mut g, &ov, start);
+    g.finish();
+}
+
+/// The overlay drawn, hovered, and dragged from `start` (each motion, then
+/// the redraw the host would ask for).
+fn draw_hover_and_drag(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    ov: &Overlay<'_>,
+    start: (f64, f64),
+) {
     g.bench_function("draw", |bch| {
         bch.iter(|| black_box(ov.draw(1.0, (1.0, 1.0)).unwrap()))
     });
@@ -196,13 +214,6 @@ fn bench_overlay(c: &mut Criterion) {
                 .unwrap()
         })
     });
-    // A drag of one control point: each motion edits and writes Scene
-    // Text, then the viewer redraws (the scene parsed afresh).
-    let start = {
-        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let p = &v["features"][0]["a"][0];
-        (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
-    };
     ov.pen(kOfxInteractActionPenDown, 1.0, start, (1.0, 1.0))
         .unwrap();
     let mut k = 0.0;
@@ -217,7 +228,6 @@ fn bench_overlay(c: &mut Criterion) {
     });
     ov.pen(kOfxInteractActionPenUp, 1.0, start, (1.0, 1.0))
         .unwrap();
-    g.finish();
 }
 
 criterion_group!(
@@ -270,33 +280,9 @@ fn bench_overlay_lines(c: &mut Criterion) {
     ov.draw(1.0, (1.0, 1.0)).unwrap();
     let per_draw = value_calls(&inst) - before;
     eprintln!("overlay_100_lines: {per_hover} param value calls per hover, {per_draw} per draw");
-    g.bench_function("draw", |bch| {
-        bch.iter(|| black_box(ov.draw(1.0, (1.0, 1.0)).unwrap()))
-    });
-    g.bench_function("hover_motion", |bch| {
-        bch.iter(|| {
-            ov.pen(kOfxInteractActionPenMotion, 1.0, (960.0, 540.0), (1.0, 1.0))
-                .unwrap()
-        })
-    });
-    // A drag of slot 1's A start: each motion keys the point, then the
-    // viewer redraws.
+    // A drag of slot 1's A start: each motion keys the point.
     let p = slots[0].points(Side::A)[0];
-    let start = (p.x, p.y);
-    ov.pen(kOfxInteractActionPenDown, 1.0, start, (1.0, 1.0))
-        .unwrap();
-    let mut k = 0.0;
-    g.bench_function("drag_motion_and_redraw", |bch| {
-        bch.iter(|| {
-            k += 0.01;
-            let at = (start.0 + k, start.1);
-            ov.pen(kOfxInteractActionPenMotion, 1.0, at, (1.0, 1.0))
-                .unwrap();
-            black_box(ov.draw(1.0, (1.0, 1.0)).unwrap())
-        })
-    });
-    ov.pen(kOfxInteractActionPenUp, 1.0, start, (1.0, 1.0))
-        .unwrap();
+    draw_hover_and_drag(&mut g, &ov, (p.x, p.y));
     g.finish();
 }
 

@@ -100,7 +100,14 @@ fn core_tests_fast() {
         return;
     }
     let (mut c, _) = fast_cargo();
-    c.args(["test", "--package", "morphfx", "--lib", "--features", "testing"]);
+    c.args([
+        "test",
+        "--package",
+        "morphfx",
+        "--lib",
+        "--features",
+        "testing",
+    ]);
     run_cargo(c);
 }
 
@@ -221,7 +228,10 @@ fn test(cargo_args: &[String]) {
 fn timed<T>(what: &str, step: impl FnOnce() -> T) -> T {
     let started = Instant::now();
     let out = step();
-    println!("xtask test: {what}: {:.0} s", started.elapsed().as_secs_f64());
+    println!(
+        "xtask test: {what}: {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
     out
 }
 
