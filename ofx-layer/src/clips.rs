@@ -227,7 +227,7 @@ impl EffectHandle {
         self.persistent(kOfxMessageError, id, text)
     }
 
-    /// As [`EffectHandle::persistent_error`], a warning: something refused
+    /// As the persistent error a failed render sets, a warning: something refused
     /// that leaves the node working (hosts show no error badge for it).
     pub fn persistent_warning(&self, id: &CStr, text: &str) -> bool {
         self.persistent(kOfxMessageWarning, id, text)
@@ -252,7 +252,8 @@ impl EffectHandle {
         status == kOfxStatOK
     }
 
-    /// Clears the persistent message set by [`EffectHandle::persistent_error`].
+    /// Clears the node's persistent message (a failed render's error, or a
+    /// [`EffectHandle::persistent_warning`]).
     pub fn clear_persistent(&self) {
         if let Some(f) = self
             .suites

@@ -1,9 +1,9 @@
 //! The generic OpenFX layer: all FFI and all `unsafe` of the plugin, and it
 //! names no node. Nodes implement [`plugin::ImageEffect`] and its
-//! [`plugin::Overlay`]; [`exports::export!`] makes the bundle's entry points
+//! [`plugin::Overlay`]; [`export!`] makes the bundle's entry points
 //! from a list of node types. Each `unsafe` block states why it is sound;
 //! every entry point null-checks, catches unwinds and maps errors to OFX
-//! statuses ([`dispatch`], [`interact`]): no panic crosses the C ABI.
+//! statuses (`dispatch`, `interact`): no panic crosses the C ABI.
 
 mod attach;
 pub mod clips;

@@ -29,7 +29,7 @@ pub enum Evaluation {
     /// Eq. (1)–(4) at every pixel.
     Exact,
     /// A coarse grid refined where bilinear interpolation would err by more
-    /// than `tolerance` pixels ([`split`]).
+    /// than `tolerance` pixels ([`split`](super::split)).
     Adaptive {
         /// Largest interpolation error allowed (output px).
         tolerance: f64,
