@@ -23,6 +23,7 @@ pub mod morph;
 pub mod scene;
 pub mod snake;
 pub mod strokes;
+pub mod suggest;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod track;

@@ -17,6 +17,8 @@ const LAYERS: &[(&str, u32)] = &[
     ("track", 2),
     ("transition", 3),
     ("snake", 3),
+    // Suggested correspondences: corners matched with the tracker.
+    ("suggest", 3),
     ("make_warp", 4),
     ("morph", 4),
     // The ghost view compares the dissolve's warped sources.

@@ -195,6 +195,35 @@ pub enum Command {
         #[arg(long)]
         clamp_controls: bool,
     },
+    /// Propose feature pairs between plates A and B (points at corners of
+    /// A, found on B and checked both ways), and write them as a scene.
+    Suggest {
+        /// Plate A: where the points are placed.
+        #[arg(long)]
+        a: PathBuf,
+        /// Plate B: where each point of A is looked for (its own size and
+        /// coordinates).
+        #[arg(long)]
+        b: PathBuf,
+        /// The scene written: the base scene's features, then the
+        /// suggestions, each with its confidence.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// A scene of the user's own features (static): kept exactly;
+        /// suggestions keep clear of them.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Pairs proposed at most.
+        #[arg(long, default_value_t = 40)]
+        count: usize,
+        /// Pairs less sure than this (0 to 1) are left out.
+        #[arg(long, default_value_t = 0.5)]
+        min_confidence: f64,
+        /// The scene's warp method (default: the base scene's, else
+        /// hybrid).
+        #[arg(long)]
+        method: Option<String>,
+    },
     /// Follow the scene's keyed features through sequence A (and B) and
     /// write the scene with a keyframe at every frame of the range.
     Track {

@@ -3,9 +3,13 @@
 //! done, 2 bad input, 1 an internal failure).
 
 use clap::Parser;
+use morphfx::choice::Choice;
+use morphfx::make_warp::Method;
 use morphfx::snake::SnakeSettings;
+use morphfx::suggest::SuggestSettings;
 use morphfx_harness::cli::{Cli, Command, JobKind};
 use morphfx_harness::commands::snap::Snap;
+use morphfx_harness::commands::suggest::Suggest;
 use morphfx_harness::commands::{bench, demo, job, openjd, overlay, params, plugins, track};
 use morphfx_harness::host::{ErrorKind, HostError};
 use morphfx_harness::interrupt;
@@ -67,6 +71,27 @@ fn run(cli: Cli) -> Result<(), HostError> {
                 iterations,
                 clamp_controls,
                 ..SnakeSettings::default()
+            },
+        }
+        .run(),
+        Command::Suggest {
+            a,
+            b,
+            output,
+            scene,
+            count,
+            min_confidence,
+            method,
+        } => Suggest {
+            a: &a,
+            b: &b,
+            output: &output,
+            scene: scene.as_deref(),
+            method: method.as_deref().map(parse_method).transpose()?,
+            settings: SuggestSettings {
+                count,
+                min_confidence,
+                ..SuggestSettings::default()
             },
         }
         .run(),
@@ -174,4 +199,16 @@ fn submitted_job(command: &[String]) -> Result<job::Job, HostError> {
         HostError::bad(format!("morphfx job openjd: the command after --: {first}"))
     })?;
     render_job(cli.command)
+}
+
+/// `--method NAME`, by the scene format's names.
+fn parse_method(name: &str) -> Result<Method, HostError> {
+    Method::ALL
+        .iter()
+        .copied()
+        .find(|m| m.name() == name)
+        .ok_or_else(|| {
+            let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+            HostError::bad(format!("--method {name}: one of {}", names.join(", ")))
+        })
 }

@@ -73,6 +73,7 @@ impl Document {
                 .get_mut(index)
                 .ok_or_else(|| missing(feature, &format!("point {index}")))?;
             *slot = point_json(to);
+            forget_confidence(f);
             Ok(())
         })
     }
@@ -108,13 +109,15 @@ impl Document {
         delta: Vec2,
     ) -> Result<()> {
         self.edit(|doc| {
-            let points = side_points(doc.feature_at(frame, feature)?, side)?;
+            let f = doc.feature_at(frame, feature)?;
+            let points = side_points(f, side)?;
             if points.len() != from.len() {
                 return Err(missing(feature, "the points moved"));
             }
             for (slot, p) in points.iter_mut().zip(from) {
                 *slot = point_json(*p + delta);
             }
+            forget_confidence(f);
             Ok(())
         })
     }
@@ -171,6 +174,7 @@ impl Document {
                     side_points(f, side)?.insert(span + 1, point_json(p));
                 }
                 forget_track(f);
+                forget_confidence(f);
             }
             Ok(())
         })
@@ -285,6 +289,7 @@ impl Editor<'_> {
                 change(side_points(f, side)?)?;
             }
             forget_track(f);
+            forget_confidence(f);
         }
         Ok(())
     }
@@ -443,6 +448,14 @@ fn side_points(f: &mut Value, side: Side) -> Result<&mut Vec<Value>> {
 fn forget_track(f: &mut Value) {
     if let Some(o) = f.as_object_mut() {
         o.remove("track");
+    }
+}
+
+/// A suggestion's confidence describes the pair `morphfx suggest` found;
+/// once the artist moves a point, the pair is theirs.
+fn forget_confidence(f: &mut Value) {
+    if let Some(o) = f.as_object_mut() {
+        o.remove("confidence");
     }
 }
 

@@ -223,3 +223,27 @@ fn a_documents_scene_is_what_its_text_reads_as_after_every_edit() {
         same(&d);
     }
 }
+
+/// A suggestion's confidence stays through edits of other features and
+/// goes when the artist moves one of its points; out of [0, 1] it is
+/// refused.
+#[test]
+fn a_suggestions_confidence_goes_when_the_artist_moves_it() {
+    let text = r#"{"format": "morphfx-scene", "version": 1, "features": [
+        {"type": "point", "a": [[1, 2]], "b": [[3, 4]], "confidence": 0.9},
+        {"type": "point", "a": [[5, 6]], "b": [[7, 8]], "confidence": 0.6}]}"#;
+    let mut d = Document::parse(text).unwrap();
+    d.set_point(0.0, 1, Side::B, 0, Vec2::new(7.5, 8.0))
+        .unwrap();
+    let v: Value = serde_json::from_str(&d.text()).unwrap();
+    assert_eq!(v["features"][0]["confidence"], 0.9);
+    assert!(v["features"][1].get("confidence").is_none());
+    let from = [Vec2::new(1.0, 2.0)];
+    d.move_feature(0.0, 0, Side::A, &from, Vec2::new(1.0, 0.0))
+        .unwrap();
+    let v: Value = serde_json::from_str(&d.text()).unwrap();
+    assert!(v["features"][0].get("confidence").is_none());
+    let wrong = text.replace("0.9", "1.5");
+    let e = Document::parse(&wrong).unwrap_err().to_string();
+    assert!(e.contains("confidence 1.5 must be between 0 and 1"), "{e}");
+}

@@ -93,6 +93,9 @@ struct RawFeature {
     a: Vec<[f64; 2]>,
     b: Vec<[f64; 2]>,
     closed: Option<bool>,
+    /// How sure `morphfx suggest` was of the pair, `[0, 1]`: checked, then
+    /// read past (it guides the artist, not the warp).
+    confidence: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -442,6 +445,12 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
                 raw.a.len(),
                 raw.b.len()
             ),
+        ));
+    }
+    if let Some(c) = raw.confidence.filter(|c| !(0.0..=1.0).contains(c)) {
+        return Err(Error::scene(
+            &at,
+            format!("confidence {c} must be between 0 and 1"),
         ));
     }
     let closed = raw.closed.unwrap_or(false);

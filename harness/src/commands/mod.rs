@@ -9,4 +9,5 @@ pub mod overlay;
 pub mod params;
 pub mod plugins;
 pub mod snap;
+pub mod suggest;
 pub mod track;

@@ -14,3 +14,4 @@ mod long_run;
 mod mattes_cli;
 mod methods;
 mod sequences;
+mod suggest;

@@ -1,0 +1,305 @@
+//! `morphfx suggest` as a user runs it, scored against the truth: a real
+//! photograph and the same photograph under a known smooth non-rigid
+//! warp, a gain and grain, so where every point of A truly went on B is
+//! known.
+
+use std::path::Path;
+
+use morphfx::geom::{RectI, Vec2};
+use morphfx::image::Image;
+use morphfx::testing::Lcg;
+use morphfx_harness::io::{self, ExrPrecision};
+use morphfx_harness::plate::Plate;
+use serde_json::Value;
+
+use crate::common::{percentile, run_morphfx, scratch};
+
+fn data(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// B's pixel `q` shows A at `q + displacement(q)`: a smooth bend of up to
+/// about 8 px, different across and along, varying over 250 to 600 px
+/// (several times the 40 suggestions' spacing on a 512 × 256 plate; a warp
+/// that turns faster needs more of them, docs/user-guide.md).
+fn displacement(q: Vec2) -> Vec2 {
+    use std::f64::consts::TAU;
+    Vec2::new(
+        5.0 * (TAU * q.y / 300.0 + 0.3).sin() + 3.0 * (TAU * q.x / 600.0).sin(),
+        4.0 * (TAU * q.x / 450.0).cos() + 2.0 * (TAU * q.y / 250.0).sin(),
+    )
+}
+
+/// Where A's point `p` truly is on B: the `q` with `q + d(q) = p`.
+fn truth(p: Vec2) -> Vec2 {
+    let mut q = p;
+    for _ in 0..50 {
+        q = p - displacement(q);
+    }
+    q
+}
+
+/// Bilinear sample of `image` channel `c` at canonical `p`, edges held.
+fn sample(image: &Image, p: Vec2, c: usize) -> f32 {
+    let b = image.view().bounds();
+    let view = image.view();
+    let at = |i: i32, j: i32| {
+        let (i, j) = (i.clamp(b.x1, b.x2 - 1), j.clamp(b.y1, b.y2 - 1));
+        view.row(j)[(i - b.x1) as usize * image.view().channels() + c]
+    };
+    let (u, v) = (p.x - 0.5, p.y - 0.5);
+    let (i, j) = (u.floor() as i32, v.floor() as i32);
+    let (fx, fy) = ((u - u.floor()) as f32, (v - v.floor()) as f32);
+    let top = at(i, j) * (1.0 - fx) + at(i + 1, j) * fx;
+    let bottom = at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// `plate` tone-mapped into [0, 1) (Reinhard's `v / (1 + v)`).
+fn display(plate: &Plate) -> Plate {
+    let v = plate.image.view();
+    let image = Image::from_fn(v.bounds(), v.channels(), |i, j, c| {
+        let x = v.row(j)[(i - v.bounds().x1) as usize * v.channels() + c].max(0.0);
+        x / (1.0 + x)
+    });
+    Plate::new(image, plate.size)
+}
+
+/// B: A under the warp, its brightness times `gain`, and 1 % grain.
+fn warped(a: &Plate, gain: f32) -> Plate {
+    let mut noise = Lcg::new(46);
+    let channels = a.image.view().channels();
+    let bounds = a.image.view().bounds();
+    let grain: Vec<f32> = (0..bounds.area() * channels)
+        .map(|_| (noise.range(-1.0, 1.0) * 1.7) as f32)
+        .collect();
+    let w = bounds.width();
+    let image = Image::from_fn(bounds, channels, |i, j, c| {
+        let q = Vec2::new(i as f64 + 0.5, j as f64 + 0.5);
+        let v = gain * sample(&a.image, q + displacement(q), c);
+        let n = grain[((j - bounds.y1) as usize * w + (i - bounds.x1) as usize) * channels + c];
+        v * (1.0 + 0.01 * n)
+    });
+    Plate::new(image, a.size)
+}
+
+/// The suggested pairs of a scene: A point, B point, confidence.
+fn pairs(scene: &Value) -> Vec<(Vec2, Vec2, f64)> {
+    let point = |v: &Value| Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
+    scene["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f.get("confidence").is_some())
+        .map(|f| {
+            (
+                point(&f["a"][0]),
+                point(&f["b"][0]),
+                f["confidence"].as_f64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Share of the 8 px cells of A with texture (a grey range of at least
+/// 0.05 on a log scale... measured as the cell's luminance spread) that
+/// lie inside the suggestions' convex hull: where the suggested scene
+/// drives the warp.
+fn coverage(a: &Plate, points: &[Vec2]) -> f64 {
+    let hull = convex_hull(points);
+    let b = a.image.view().bounds();
+    let (mut textured, mut covered) = (0, 0);
+    for cy in (b.y1..b.y2 - 8).step_by(8) {
+        for cx in (b.x1..b.x2 - 8).step_by(8) {
+            let lum: Vec<f64> = (0..64)
+                .map(|k| {
+                    let p = Vec2::new((cx + k % 8) as f64 + 0.5, (cy + k / 8) as f64 + 0.5);
+                    (sample(&a.image, p, 1).max(0.0) as f64 + 1.0 / 256.0).log2()
+                })
+                .collect();
+            let (lo, hi) = lum
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+            if hi - lo < 0.25 {
+                continue;
+            }
+            textured += 1;
+            let centre = Vec2::new(cx as f64 + 4.0, cy as f64 + 4.0);
+            covered += inside(&hull, centre) as usize;
+        }
+    }
+    covered as f64 / textured.max(1) as f64
+}
+
+/// The convex hull, counter-clockwise (Andrew's monotone chain).
+fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
+    let mut p = points.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    let cross = |o: Vec2, a: Vec2, b: Vec2| (a - o).x * (b - o).y - (a - o).y * (b - o).x;
+    let mut hull: Vec<Vec2> = Vec::new();
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &Vec2>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
+        for &q in iter {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+fn inside(hull: &[Vec2], p: Vec2) -> bool {
+    hull.len() >= 3
+        && (0..hull.len()).all(|k| {
+            let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+            (b - a).x * (p - a).y - (b - a).y * (p - a).x >= 0.0
+        })
+}
+
+/// The suggestions on real photographs under a known warp land where A's
+/// points truly went: at least 20, median error at most 0.5 px, 95th
+/// percentile at most 1.5 px, over at least 60 % of the textured plate;
+/// and the morph they drive ghosts at most half as much as a dissolve.
+#[test]
+fn suggestions_on_a_warped_photograph_land_where_the_points_went() {
+    for photo in ["venice.exr", "forest.exr"] {
+        on_a_warped(photo);
+    }
+}
+
+fn on_a_warped(photo: &str) {
+    let dir = scratch(&format!("suggest-{photo}"));
+    // Display-referred, as most plates of a comp are: an HDR sky's values
+    // of 60 would make any ghost of it saturate.
+    let a = display(&io::read(&data(photo)).unwrap());
+    let b = warped(&a, 1.2);
+    let (pa, pb, out) = (
+        dir.join("a.exr"),
+        dir.join("b.exr"),
+        dir.join("s.morph.json"),
+    );
+    io::write(&pb, &b, ExrPrecision::Float).unwrap();
+    // The same B without the gain, for the ghost: a warp cannot change
+    // brightness, so a gain shows as ghost under any warp.
+    let pb_unit = dir.join("b-unit.exr");
+    io::write(&pb_unit, &warped(&a, 1.0), ExrPrecision::Float).unwrap();
+    io::write(&pa, &a, ExrPrecision::Float).unwrap();
+    let run = run_morphfx(&[
+        "suggest",
+        "--a",
+        pa.to_str().unwrap(),
+        "--b",
+        pb.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{said}");
+    let scene: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(scene["method"], "hybrid");
+    let found = pairs(&scene);
+    let mut errors: Vec<f64> = found
+        .iter()
+        .map(|(pa, pb, _)| pb.distance(truth(*pa)))
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let (median, p95) = (percentile(&errors, 0.5), percentile(&errors, 0.95));
+    let points: Vec<Vec2> = found.iter().map(|f| f.0).collect();
+    let covered = coverage(&a, &points);
+    eprintln!(
+        "suggest on {photo}: {} pairs, error median {median:.3} px, 95th {p95:.3} px, \
+         coverage {:.0} %",
+        found.len(),
+        covered * 100.0
+    );
+    assert!(found.len() >= 20, "{} pairs", found.len());
+    assert!(median <= 0.5 && p95 <= 1.5, "median {median}, 95th {p95}");
+    assert!(covered >= 0.6, "coverage {covered}");
+    assert!(found.iter().all(|f| (0.0..=1.0).contains(&f.2)));
+
+    // The morph the scene drives ghosts at most half as much as a plain
+    // dissolve (the same scene with every B point on its A point), with
+    // B's gain divided back out.
+    let mut still = scene.clone();
+    for f in still["features"].as_array_mut().unwrap() {
+        f["b"] = f["a"].clone();
+    }
+    let still_path = dir.join("still.morph.json");
+    std::fs::write(&still_path, still.to_string()).unwrap();
+    let ghost = |scene: &Path, name: &str| {
+        let out = dir.join(format!("ghost-{name}.exr"));
+        let run = run_morphfx(&[
+            "morph",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--a",
+            pa.to_str().unwrap(),
+            "--b",
+            pb_unit.to_str().unwrap(),
+            "--t",
+            "0.5",
+            "--view",
+            "ghost",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let g = io::read(&out).unwrap().image;
+        let v = g.view();
+        let alpha: f64 = (0..v.bounds().height() as i32)
+            .flat_map(|j| v.row(j).chunks(4).map(|p| p[3] as f64).collect::<Vec<_>>())
+            .sum();
+        alpha / v.bounds().area() as f64
+    };
+    let dissolve = ghost(&still_path, "dissolve");
+    let g = ghost(&out, "suggested");
+    eprintln!(
+        "ghost on {photo}: {g:.4}, plain dissolve {dissolve:.4}, ratio {:.2}",
+        g / dissolve
+    );
+    assert!(g <= 0.5 * dissolve, "ghost {g} against {dissolve}");
+}
+
+/// A blank plate has nothing to match: exit status 2, a message saying so,
+/// nothing written.
+#[test]
+fn a_blank_plate_gives_no_suggestions_and_writes_nothing() {
+    let dir = scratch("suggest-blank");
+    let flat = Plate::new(
+        Image::from_fn(RectI::from_size(96, 64), 3, |_, _, _| 0.4),
+        (96, 64),
+    );
+    let (pa, out) = (dir.join("flat.exr"), dir.join("s.morph.json"));
+    io::write(&pa, &flat, ExrPrecision::Float).unwrap();
+    let v = data("venice.exr");
+    for (a, b) in [(pa.as_path(), v.as_path()), (pa.as_path(), pa.as_path())] {
+        let run = run_morphfx(&[
+            "suggest",
+            "--a",
+            a.to_str().unwrap(),
+            "--b",
+            b.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let said = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{said}");
+        assert!(said.contains("nothing to suggest"), "{said}");
+        assert!(!out.exists());
+    }
+}
