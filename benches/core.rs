@@ -415,25 +415,49 @@ fn bench_snakes(c: &mut Criterion) {
 }
 
 /// A textured plate pair of `w x h` where B is A under a smooth warp of up
-/// to 2% of the frame (the kind of pair `auto` is for).
-fn auto_pair(w: usize, h: usize) -> (WorkImage, WorkImage) {
-    // The texture at the scale of a 256-wide plate, whatever the size.
-    let tex = |x: f64, y: f64| texture(Vec2::new(x, y) * (256.0 / w as f64));
-    let warp = |x: f64, y: f64| {
-        let (u, v) = (x / w as f64, y / h as f64);
+/// to 2% of the frame (the kind of pair `auto` is for). The texture is
+/// drawn at the scale of a `detail`-pixel-wide plate, whatever the size.
+#[derive(Clone, Copy)]
+struct BentTexture {
+    w: f64,
+    h: f64,
+    detail: f64,
+}
+
+impl BentTexture {
+    fn new(w: usize, h: usize, detail: f64) -> Self {
+        BentTexture {
+            w: w as f64,
+            h: h as f64,
+            detail,
+        }
+    }
+
+    /// A's colour at canonical `(x, y)`.
+    fn a(&self, x: f64, y: f64) -> [f32; 3] {
+        texture(Vec2::new(x, y) * (self.detail / self.w))
+    }
+
+    /// B's: A's where the warp takes the point.
+    fn b(&self, x: f64, y: f64) -> [f32; 3] {
+        let (u, v) = (x / self.w, y / self.h);
         let bump = (std::f64::consts::PI * u).sin() * (std::f64::consts::PI * v).sin();
-        let m = 0.02 * w as f64;
-        (
+        let m = 0.02 * self.w;
+        self.a(
             x + m * bump * (2.0 * v).cos(),
             y - m * bump * (3.0 * u).sin(),
         )
-    };
-    let a = WorkImage::from_fn(w, h, |i, j| tex(i as f64 + 0.5, j as f64 + 0.5));
-    let b = WorkImage::from_fn(w, h, |i, j| {
-        let (x, y) = warp(i as f64 + 0.5, j as f64 + 0.5);
-        tex(x, y)
-    });
-    (a, b)
+    }
+}
+
+/// [`BentTexture`]'s pair at the scale of a 256-wide plate, as `auto`
+/// reads plates.
+fn auto_pair(w: usize, h: usize) -> (WorkImage, WorkImage) {
+    let t = BentTexture::new(w, h, 256.0);
+    (
+        WorkImage::from_fn(w, h, |i, j| t.a(i as f64 + 0.5, j as f64 + 0.5)),
+        WorkImage::from_fn(w, h, |i, j| t.b(i as f64 + 0.5, j as f64 + 0.5)),
+    )
 }
 
 fn bench_auto(c: &mut Criterion) {
@@ -570,8 +594,46 @@ fn bench_transition(c: &mut Criterion) {
     g.finish();
 }
 
+/// `suggest` on a 1080p textured pair (B: A under `auto_pair`'s bend),
+/// guide included, beside converting both plates to grey (the least any
+/// matcher does first).
+fn bench_suggest(c: &mut Criterion) {
+    use morphfx::geom::RectD;
+    use morphfx::suggest::{suggest, work_guide, SuggestSettings};
+    use morphfx::track::Grey;
+    let (w, h) = (1920, 1080);
+    // Texture at every scale a 1080p plate has it, down to a few pixels.
+    let t = BentTexture::new(w, h, w as f64);
+    let at = |i: usize, j: usize| (i as f64 + 0.5, j as f64 + 0.5);
+    let wa = WorkImage::from_fn(w, h, |i, j| t.a(at(i, j).0, at(i, j).1));
+    let wb = WorkImage::from_fn(w, h, |i, j| t.b(at(i, j).0, at(i, j).1));
+    let grey = |side_b: bool| {
+        Grey::from_fn(morphfx::geom::RectI::from_size(w, h), |i, j| {
+            let (x, y) = (i as f64 + 0.5, j as f64 + 0.5);
+            let [r, g, b] = if side_b { t.b(x, y) } else { t.a(x, y) };
+            0.2126 * r + 0.7152 * g + 0.0722 * b
+        })
+    };
+    let frame = RectD::new(0.0, 0.0, w as f64, h as f64);
+    let mut g = c.benchmark_group("suggest_1080p");
+    g.sample_size(10);
+    g.bench_function("peer_grey_of_both", |b| {
+        b.iter(|| black_box((grey(false), grey(true))))
+    });
+    g.bench_function("guide_and_40_pairs", |b| {
+        b.iter(|| {
+            let (ga, gb) = (grey(false), grey(true));
+            let map = work_guide(&wa, frame, &wb, frame, &[]).unwrap();
+            let guide = move |p: Vec2| map.map_a_to_b(p);
+            black_box(suggest(&ga, &gb, &guide, &[], &SuggestSettings::default()).unwrap())
+        })
+    });
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    bench_suggest,
     bench_scattered,
     bench_transition,
     bench_auto,

@@ -18,9 +18,11 @@ mod corners;
 pub use corners::{corners, Corner, MIN_STRENGTH};
 
 use crate::error::{Error, Result};
-use crate::geom::Vec2;
+use crate::features::Feature;
+use crate::geom::{RectD, Vec2};
 use crate::track::template::{Affine, Template, TrackSettings};
 use crate::track::{Grey, Pyramid};
+use crate::warp::auto::{correspond, AutoSettings, Correspondence, WorkImage};
 
 /// What `suggest` proposes, and how sure it must be.
 #[derive(Debug, Clone, PartialEq)]
@@ -145,6 +147,43 @@ fn spread_out(mut matched: Vec<Suggestion>, a: &Grey, count: usize, clear: f64) 
         }
     }
     kept
+}
+
+/// The longer side, in pixels, the guide's pictures are brought down to:
+/// the least-work search sees a picture's large shapes (a face's outline,
+/// where its eyes are), which is what a guide needs, in well under a
+/// second.
+pub const GUIDE_SIDE: usize = 256;
+
+/// A guide for plates of different subjects: the least-work warp of A
+/// onto B (Gao and Sederberg), found on the pictures brought down to about
+/// [`GUIDE_SIDE`] pixels, with `anchors` (the user's features) held.
+/// Frames are the plates' canonical frames; the map it gives takes A's
+/// canonical points to B's.
+pub fn work_guide(
+    a: &WorkImage,
+    a_frame: RectD,
+    b: &WorkImage,
+    b_frame: RectD,
+    anchors: &[Feature],
+) -> Result<Correspondence> {
+    let small = |im: &WorkImage| {
+        if im.width.max(im.height) <= GUIDE_SIDE {
+            return im.clone();
+        }
+        let mut levels = im.halvings(8);
+        let fit = levels
+            .iter()
+            .position(|l| l.width.max(l.height) <= GUIDE_SIDE);
+        match fit {
+            Some(k) => levels.swap_remove(k),
+            None => levels.pop().unwrap_or_else(|| im.clone()),
+        }
+    };
+    let (sa, sb) = (small(a), small(b));
+    let settings = AutoSettings::default();
+    let (found, _) = correspond(&sa, a_frame, &sb, b_frame, anchors, 4, &settings, None)?;
+    Ok(found)
 }
 
 /// The distance between suggestions: `count` of them spread over A.

@@ -10,8 +10,9 @@ use morphfx::choice::Choice;
 use morphfx::geom::{RectD, Vec2};
 use morphfx::make_warp::Method;
 use morphfx::scene::Scene;
-use morphfx::suggest::{suggest, SuggestSettings, Suggestion};
+use morphfx::suggest::{suggest, work_guide, SuggestSettings, Suggestion};
 use morphfx::track::Grey;
+use morphfx::warp::auto::WorkImage;
 use serde_json::{json, Value};
 
 use crate::error::HostError;
@@ -46,19 +47,25 @@ impl Suggest<'_> {
         let (pa, pb) = (io::read(self.a)?, io::read(self.b)?);
         let (ga, gb) = (grey(&pa), grey(&pb));
         let (fa, fb) = (frame(&pa), frame(&pb));
-        // Each plate in its own coordinates: the search starts where the
-        // point lies at the same place in B's frame.
-        let guide = move |p: Vec2| {
-            let u = Vec2::new((p.x - fa.x1) / fa.width(), (p.y - fa.y1) / fa.height());
-            Vec2::new(fb.x1 + u.x * fb.width(), fb.y1 + u.y * fb.height())
-        };
-        let user = base.as_ref().map_or_else(Vec::new, |(scene, _)| {
-            scene
-                .features_at(0.0)
-                .iter()
-                .flat_map(|f| f.a.clone())
-                .collect()
-        });
+        let features = base
+            .as_ref()
+            .map_or_else(Vec::new, |(scene, _)| scene.features_at(0.0));
+        // Each plate in its own coordinates; the search on B starts where
+        // the least-work warp of A onto B (the user's features held) puts
+        // the point, which finds a second subject's eyes on its eyes.
+        let (wa, wb) = (
+            WorkImage::from_view(&pa.image.view()),
+            WorkImage::from_view(&pb.image.view()),
+        );
+        let map = work_guide(&wa, fa, &wb, fb, &features).map_err(|e| {
+            HostError::bad(format!(
+                "{} and {}: {e}",
+                self.a.display(),
+                self.b.display()
+            ))
+        })?;
+        let guide = move |p: Vec2| map.map_a_to_b(p);
+        let user: Vec<Vec2> = features.iter().flat_map(|f| f.a.clone()).collect();
         let found = suggest(&ga, &gb, &guide, &user, &self.settings).map_err(|e| {
             HostError::bad(format!(
                 "{} and {}: {e}",

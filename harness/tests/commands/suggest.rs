@@ -303,3 +303,151 @@ fn a_blank_plate_gives_no_suggestions_and_writes_nothing() {
         assert!(!out.exists());
     }
 }
+
+/// `morphfx suggest --a A --b B -o OUT` and more arguments; the scene
+/// written, or the run's stderr.
+fn run_suggest(a: &Path, b: &Path, out: &Path, more: &[&str]) -> Result<Value, String> {
+    let mut args = vec![
+        "suggest",
+        "--a",
+        a.to_str().unwrap(),
+        "--b",
+        b.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(more);
+    let run = run_morphfx(&args);
+    if !run.status.success() {
+        return Err(String::from_utf8_lossy(&run.stderr).into_owned());
+    }
+    Ok(serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap())
+}
+
+/// Plates of different sizes: each in its own coordinates. B is A under
+/// the bend, brought down to three quarters: A's point p is truly at
+/// 0.75 × truth(p) on B.
+#[test]
+fn plates_of_different_sizes_are_each_in_their_own_coordinates() {
+    let dir = scratch("suggest-sizes");
+    let a = display(&io::read(&data("venice.exr")).unwrap());
+    let bent = warped(&a, 1.0);
+    let (w, h) = (384, 192);
+    let small = Image::from_fn(RectI::from_size(w, h), 3, |i, j, c| {
+        let q = Vec2::new((i as f64 + 0.5) / 0.75, (j as f64 + 0.5) / 0.75);
+        // The mean of the 4/3-pixel footprint, near enough: four taps.
+        let d = 1.0 / 3.0;
+        [(-d, -d), (d, -d), (-d, d), (d, d)]
+            .iter()
+            .map(|&(x, y)| sample(&bent.image, q + Vec2::new(x, y), c))
+            .sum::<f32>()
+            / 4.0
+    });
+    let (pa, pb, out) = (
+        dir.join("a.exr"),
+        dir.join("b.exr"),
+        dir.join("s.morph.json"),
+    );
+    io::write(&pa, &a, ExrPrecision::Float).unwrap();
+    io::write(&pb, &Plate::new(small, (w, h)), ExrPrecision::Float).unwrap();
+    let scene = run_suggest(&pa, &pb, &out, &[]).expect("suggested");
+    let found = pairs(&scene);
+    let mut errors: Vec<f64> = found
+        .iter()
+        .map(|(p, q, _)| q.distance(truth(*p) * 0.75))
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let median = percentile(&errors, 0.5);
+    eprintln!(
+        "suggest across sizes: {} pairs, median error {median:.3} px",
+        found.len()
+    );
+    assert!(
+        found.len() >= 20 && median <= 0.5,
+        "{} pairs, median {median}",
+        found.len()
+    );
+}
+
+/// The user's own features are kept exactly, first, and suggestions keep
+/// clear of them; a keyed base scene is refused, as are bad counts and
+/// confidences, each with exit status 2 and nothing written.
+#[test]
+fn the_users_features_are_kept_and_suggestions_keep_clear_of_them() {
+    let dir = scratch("suggest-base");
+    let a = display(&io::read(&data("venice.exr")).unwrap());
+    let (pa, pb) = (dir.join("a.exr"), dir.join("b.exr"));
+    io::write(&pa, &a, ExrPrecision::Float).unwrap();
+    io::write(&pb, &warped(&a, 1.0), ExrPrecision::Float).unwrap();
+    let mine = serde_json::json!([
+        {"name": "roof", "type": "line", "a": [[100, 150], [180, 160]], "b": [[101, 152], [181, 161]]},
+        {"name": "spire", "type": "point", "a": [[300, 120]], "b": [[302, 121]]}
+    ]);
+    let base = serde_json::json!({"format": "morphfx-scene", "version": 1, "method": "mffd",
+        "features": mine.clone(), "x-studio": {"shot": 7}});
+    let base_path = dir.join("base.morph.json");
+    std::fs::write(&base_path, base.to_string()).unwrap();
+    let out = dir.join("s.morph.json");
+    let scene =
+        run_suggest(&pa, &pb, &out, &["--scene", base_path.to_str().unwrap()]).expect("suggested");
+    let features = scene["features"].as_array().unwrap();
+    assert_eq!(
+        features[..2],
+        mine.as_array().unwrap()[..],
+        "the user's features"
+    );
+    assert_eq!(scene["method"], "mffd", "the base scene's method stays");
+    assert_eq!(
+        scene["x-studio"]["shot"], 7,
+        "keys the tool does not know stay"
+    );
+    let users = [
+        Vec2::new(100.0, 150.0),
+        Vec2::new(180.0, 160.0),
+        Vec2::new(300.0, 120.0),
+    ];
+    let found = pairs(&scene);
+    assert!(found.len() >= 20, "{} pairs", found.len());
+    for (p, _, _) in &found {
+        let near = users
+            .iter()
+            .map(|u| u.distance(*p))
+            .fold(f64::MAX, f64::min);
+        assert!(
+            near >= 10.0,
+            "a suggestion {near:.1} px from the user's point"
+        );
+    }
+
+    let keyed = serde_json::json!({"format": "morphfx-scene", "version": 1,
+        "keyframes": [{"frame": 1, "features": mine}]});
+    let keyed_path = dir.join("keyed.morph.json");
+    std::fs::write(&keyed_path, keyed.to_string()).unwrap();
+    let bad_out = dir.join("never.morph.json");
+    for (more, said) in [
+        (vec!["--scene", keyed_path.to_str().unwrap()], "keyframes"),
+        (vec!["--count", "0"], "--count 0"),
+        (vec!["--min-confidence", "1.5"], "--min-confidence 1.5"),
+        (vec!["--method", "magic"], "--method magic"),
+    ] {
+        let run = run_morphfx(
+            &[
+                vec![
+                    "suggest",
+                    "--a",
+                    pa.to_str().unwrap(),
+                    "--b",
+                    pb.to_str().unwrap(),
+                    "-o",
+                    bad_out.to_str().unwrap(),
+                ],
+                more,
+            ]
+            .concat(),
+        );
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{err}");
+        assert!(err.contains(said), "{said}: {err}");
+        assert!(!bad_out.exists());
+    }
+}
