@@ -198,13 +198,22 @@ pub enum Command {
     /// Propose feature pairs between plates A and B (points at corners of
     /// A, found on B and checked both ways), and write them as a scene.
     Suggest {
-        /// Plate A: where the points are placed.
+        /// Plate A: where the points are placed (with --frames, a
+        /// #-numbered sequence).
         #[arg(long)]
-        a: PathBuf,
+        a: String,
         /// Plate B: where each point of A is looked for (its own size and
-        /// coordinates).
+        /// coordinates; with --frames, a #-numbered sequence).
         #[arg(long)]
-        b: PathBuf,
+        b: String,
+        /// Sequences: suggest at --at, then follow every feature through
+        /// both sequences over this range (FIRST-LAST), keyed at every frame.
+        #[arg(long)]
+        frames: Option<String>,
+        /// The frame of --frames the suggestions are made at (default: its
+        /// first).
+        #[arg(long)]
+        at: Option<i64>,
         /// The scene written: the base scene's features, then the
         /// suggestions, each with its confidence.
         #[arg(short = 'o', long = "output")]

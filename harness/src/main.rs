@@ -77,6 +77,8 @@ fn run(cli: Cli) -> Result<(), HostError> {
         Command::Suggest {
             a,
             b,
+            frames,
+            at,
             output,
             scene,
             count,
@@ -85,6 +87,8 @@ fn run(cli: Cli) -> Result<(), HostError> {
         } => Suggest {
             a: &a,
             b: &b,
+            frames: frames.as_deref(),
+            at,
             output: &output,
             scene: scene.as_deref(),
             method: method.as_deref().map(parse_method).transpose()?,

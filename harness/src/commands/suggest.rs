@@ -11,13 +11,15 @@ use morphfx::geom::{RectD, Vec2};
 use morphfx::make_warp::Method;
 use morphfx::scene::Scene;
 use morphfx::suggest::{suggest, work_guide, SuggestSettings, Suggestion};
-use morphfx::track::Grey;
+use morphfx::track::{Grey, TrackSettings};
 use morphfx::warp::auto::WorkImage;
 use serde_json::{json, Value};
 
+use crate::commands::track::track_job;
 use crate::error::HostError;
 use crate::io;
 use crate::plate::Plate;
+use crate::sequence::{frame_path, is_sequence, parse_frames};
 
 /// The method a suggested scene renders with when the base scene names
 /// none. Points at corners drive every scattered-point method; on real
@@ -30,9 +32,14 @@ pub const DEFAULT_METHOD: Method = Method::Hybrid;
 
 /// What `suggest` was asked to do.
 pub struct Suggest<'a> {
-    pub a: &'a Path,
-    pub b: &'a Path,
+    /// Plate A, or sequence A (`#`-numbered) with `frames`.
+    pub a: &'a str,
+    pub b: &'a str,
     pub output: &'a Path,
+    /// Sequences: the range every suggested feature is tracked through,
+    /// and the frame the suggestions are made at (default its first).
+    pub frames: Option<&'a str>,
+    pub at: Option<i64>,
     /// The user's scene: its features are kept exactly and suggestions
     /// keep clear of them.
     pub scene: Option<&'a Path>,
@@ -44,7 +51,12 @@ impl Suggest<'_> {
     pub fn run(&self) -> Result<(), HostError> {
         let base = self.base()?;
         check(&self.settings)?;
-        let (pa, pb) = (io::read(self.a)?, io::read(self.b)?);
+        let at = self.frame()?;
+        let plate = |pattern: &str| match at {
+            Some((frame, _)) => io::read(&frame_path(pattern, frame)),
+            None => io::read(Path::new(pattern)),
+        };
+        let (pa, pb) = (plate(self.a)?, plate(self.b)?);
         let (ga, gb) = (grey(&pa), grey(&pb));
         let (fa, fb) = (frame(&pa), frame(&pb));
         let features = base
@@ -57,28 +69,24 @@ impl Suggest<'_> {
             WorkImage::from_view(&pa.image.view()),
             WorkImage::from_view(&pb.image.view()),
         );
-        let map = work_guide(&wa, fa, &wb, fb, &features).map_err(|e| {
-            HostError::bad(format!(
-                "{} and {}: {e}",
-                self.a.display(),
-                self.b.display()
-            ))
-        })?;
+        let map = work_guide(&wa, fa, &wb, fb, &features)
+            .map_err(|e| HostError::bad(format!("{} and {}: {e}", self.a, self.b)))?;
         let guide = move |p: Vec2| map.map_a_to_b(p);
         let user: Vec<Vec2> = features.iter().flat_map(|f| f.a.clone()).collect();
-        let found = suggest(&ga, &gb, &guide, &user, &self.settings).map_err(|e| {
-            HostError::bad(format!(
-                "{} and {}: {e}",
-                self.a.display(),
-                self.b.display()
-            ))
-        })?;
-        let doc = self.scene_with(base.map(|(_, doc)| doc), &found)?;
+        let found = suggest(&ga, &gb, &guide, &user, &self.settings)
+            .map_err(|e| HostError::bad(format!("{} and {}: {e}", self.a, self.b)))?;
+        let mut doc = self.scene_with(base.map(|(_, doc)| doc), &found)?;
+        if let Some((frame, _)) = at {
+            keyed_at(&mut doc, frame);
+        }
         let out = serde_json::to_string_pretty(&doc)
             .map_err(|e| HostError::failed(format!("cannot write the scene: {e}")))?;
         Scene::parse(&out)
             .map_err(|e| HostError::failed(format!("the suggested scene is invalid: {e}")))?;
-        io::write_text(self.output, &out)?;
+        match at {
+            Some((_, frames)) => self.track(&out, frames)?,
+            None => io::write_text(self.output, &out)?,
+        }
         let (lo, hi) = found.iter().fold((1.0f64, 0.0f64), |(lo, hi), s| {
             (lo.min(s.confidence), hi.max(s.confidence))
         });
@@ -88,6 +96,58 @@ impl Suggest<'_> {
             self.output.display()
         );
         Ok(())
+    }
+
+    /// With `--frames`: the frame suggestions are made at, and the range.
+    fn frame(&self) -> Result<Option<(i64, &str)>, HostError> {
+        let Some(frames) = self.frames else {
+            if self.at.is_some() {
+                return Err(HostError::bad("--at names a frame of --frames: give both"));
+            }
+            return Ok(None);
+        };
+        for pattern in [self.a, self.b] {
+            if !is_sequence(pattern) {
+                return Err(HostError::bad(format!(
+                    "{pattern}: with --frames, A and B are #-numbered sequences (plate.####.exr)"
+                )));
+            }
+        }
+        let range = parse_frames(frames)?;
+        let at = self.at.unwrap_or(range[0]);
+        if !range.contains(&at) {
+            return Err(HostError::bad(format!(
+                "--at {at}: not a frame of --frames {frames}"
+            )));
+        }
+        Ok(Some((at, frames)))
+    }
+
+    /// Follows the suggested scene (keyed at one frame) through both
+    /// sequences with the tracker, as `morphfx track` does, into the
+    /// output; the scene in between lies beside the output and goes.
+    fn track(&self, scene: &str, frames: &str) -> Result<(), HostError> {
+        let name = self
+            .output
+            .file_name()
+            .map_or("scene".into(), |n| n.to_string_lossy());
+        let folder = self.output.parent().filter(|p| !p.as_os_str().is_empty());
+        let keyed = folder
+            .unwrap_or(Path::new("."))
+            .join(format!(".{name}.suggested-{}", std::process::id()));
+        io::write_text(&keyed, scene)?;
+        let defaults = TrackSettings::default();
+        let tracked = track_job(
+            &keyed,
+            self.a,
+            Some(self.b),
+            frames,
+            Some(self.output),
+            defaults.radius,
+            defaults.min_correlation,
+        );
+        let _ = std::fs::remove_file(&keyed);
+        tracked
     }
 
     /// The base scene, parsed and as JSON; a keyed one is refused (its
@@ -136,6 +196,17 @@ impl Suggest<'_> {
             }));
         }
         Ok(doc)
+    }
+}
+
+/// The scene's features moved into one keyframe at `frame`.
+fn keyed_at(doc: &mut Value, frame: i64) {
+    if let Some(root) = doc.as_object_mut() {
+        let features = root.remove("features").unwrap_or_else(|| json!([]));
+        root.insert(
+            "keyframes".into(),
+            json!([{"frame": frame, "features": features}]),
+        );
     }
 }
 

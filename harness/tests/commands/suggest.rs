@@ -451,3 +451,58 @@ fn the_users_features_are_kept_and_suggestions_keep_clear_of_them() {
         assert!(!bad_out.exists());
     }
 }
+
+/// `plate` moved by `d` pixels (a pan), edges held.
+fn panned(plate: &Plate, d: Vec2) -> Plate {
+    let v = plate.image.view();
+    let image = Image::from_fn(v.bounds(), v.channels(), |i, j, c| {
+        sample(&plate.image, Vec2::new(i as f64 + 0.5, j as f64 + 0.5) - d, c)
+    });
+    Plate::new(image, plate.size)
+}
+
+/// Sequences: suggestions made at one frame and followed through both
+/// sequences, keyed at every frame where the pan put them.
+#[test]
+fn suggestions_on_sequences_are_tracked_through_both() {
+    let dir = scratch("suggest-frames");
+    let a = display(&io::read(&data("venice.exr")).unwrap());
+    let b = warped(&a, 1.0);
+    let pan = Vec2::new(2.0, 1.0);
+    for k in 1..=5i64 {
+        let d = pan * (k - 3) as f64;
+        for (side, plate) in [("a", &a), ("b", &b)] {
+            let path = dir.join(format!("{side}.{k:04}.exr"));
+            io::write(&path, &panned(plate, d), ExrPrecision::Float).unwrap();
+        }
+    }
+    let (sa, sb) = (dir.join("a.####.exr"), dir.join("b.####.exr"));
+    let out = dir.join("s.morph.json");
+    let scene = run_suggest(&sa, &sb, &out, &["--frames", "1-5", "--at", "3", "--count", "20"])
+        .expect("suggested and tracked");
+    let keys = scene["keyframes"].as_array().unwrap();
+    let frames: Vec<f64> = keys.iter().map(|k| k["frame"].as_f64().unwrap()).collect();
+    assert_eq!(frames, [1.0, 2.0, 3.0, 4.0, 5.0]);
+    let at = |key: &Value| pairs(&serde_json::json!({"features": key["features"]}));
+    let key3 = at(&keys[2]);
+    assert!(key3.len() >= 10, "{} pairs", key3.len());
+    let mut worst: f64 = 0.0;
+    for (k, key) in keys.iter().enumerate() {
+        let d = pan * (k as f64 - 2.0);
+        let features = key["features"].as_array().unwrap();
+        assert_eq!(features.len(), key3.len());
+        for (f, (p3, q3, _)) in features.iter().zip(&key3) {
+            let point = |v: &Value| Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
+            worst = worst.max(point(&f["a"][0]).distance(*p3 + d));
+            worst = worst.max(point(&f["b"][0]).distance(*q3 + d));
+        }
+    }
+    assert!(worst <= 0.5, "a tracked point {worst:.2} px from where the pan put it");
+    // The scene in between is gone.
+    let left: Vec<_> = std::fs::read_dir(&*dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("suggested"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
