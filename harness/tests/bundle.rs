@@ -45,6 +45,7 @@ fn features() -> Vec<Feature> {
             a: vec![v(a0), v(a1)],
             b: vec![v(b0), v(b1)],
             closed: false,
+            confidence: None,
         })
         .collect()
 }

@@ -504,3 +504,46 @@ fn morphfx_overlay_draws_closed_curves_of_a_scene() {
     assert_eq!(drawn.pixel(60, 40), plate.pixel(60, 40));
     assert_eq!(drawn.pixel(5, 5), plate.pixel(5, 5));
 }
+
+/// A suggested pair (a feature with a confidence) is drawn in its
+/// confidence's colour with the confidence in its label, on both sides,
+/// until the artist moves it: then it is drawn as theirs.
+#[test]
+fn a_suggestion_shows_its_confidence_until_the_artist_moves_it() {
+    let inst = morph();
+    let text = r#"{"format": "morphfx-scene", "version": 1, "features": [
+        {"name": "suggested 1", "type": "point", "a": [[200, 200]], "b": [[210, 205]], "confidence": 0.25}]}"#;
+    inst.set_string("scene_text", text).unwrap();
+    let ov = overlay(&inst);
+    let doubtful = [1.0, 0.625, 0.2];
+    let colours = |calls: &[DrawCall]| -> Vec<[f32; 3]> {
+        calls
+            .iter()
+            .filter_map(|c| match c {
+                DrawCall::Colour(c) if c[3] == 1.0 && c[..3] != [0.0, 0.0, 0.0] => {
+                    Some([c[0], c[1], c[2]])
+                }
+                _ => None,
+            })
+            .collect()
+    };
+    let near = |c: &[f32; 3], d: &[f32; 3]| c.iter().zip(d).all(|(x, y)| (x - y).abs() < 1e-3);
+    let calls = ov.draw(0.0, (1.0, 1.0)).unwrap();
+    assert!(
+        texts(&calls).iter().any(|t| t == "suggested 1 25%"),
+        "{:?}",
+        texts(&calls)
+    );
+    assert!(colours(&calls).iter().any(|c| near(c, &doubtful)));
+    // The artist drags A's point: the pair is theirs now.
+    ov.drag(0.0, (200.0, 200.0), (220.0, 200.0), (1.0, 1.0))
+        .unwrap();
+    let calls = ov.draw(0.0, (1.0, 1.0)).unwrap();
+    assert!(
+        texts(&calls).iter().any(|t| t == "suggested 1"),
+        "{:?}",
+        texts(&calls)
+    );
+    assert!(!colours(&calls).iter().any(|c| near(c, &doubtful)));
+    assert!(!scene_text(&inst).contains("confidence"));
+}

@@ -71,6 +71,10 @@ pub struct Feature {
     /// A polyline or curve that runs on from its last point back to its
     /// first (scene key `closed`); always false for points and lines.
     pub closed: bool,
+    /// How sure `morphfx suggest` was of the pair, `[0, 1]` (scene key
+    /// `confidence`): shown to the artist, never used by a warp. `None`
+    /// for features the artist placed or moved.
+    pub confidence: Option<f64>,
 }
 
 /// Where a feature sits on one image, or in between.
@@ -91,6 +95,7 @@ impl Feature {
             a,
             b,
             closed: false,
+            confidence: None,
         }
     }
 

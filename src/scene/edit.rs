@@ -500,6 +500,9 @@ pub fn feature_json(f: &Feature) -> Value {
     }
     o.insert("a".into(), points_json(&f.a));
     o.insert("b".into(), points_json(&f.b));
+    if let Some(c) = f.confidence {
+        o.insert("confidence".into(), number(c));
+    }
     Value::Object(o)
 }
 

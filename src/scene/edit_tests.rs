@@ -247,3 +247,26 @@ fn a_suggestions_confidence_goes_when_the_artist_moves_it() {
     let e = Document::parse(&wrong).unwrap_err().to_string();
     assert!(e.contains("confidence 1.5 must be between 0 and 1"), "{e}");
 }
+
+/// Between two keys a suggestion is as sure as its less sure end, and a
+/// key made between them keeps that; a key the artist made has none.
+#[test]
+fn confidence_between_keys_is_the_less_sure_ends() {
+    let text = r#"{"keyframes": [
+      {"frame": 0, "features": [{"type": "point", "a": [[0, 0]], "b": [[1, 1]], "confidence": 0.9}]},
+      {"frame": 10, "features": [{"type": "point", "a": [[10, 0]], "b": [[11, 1]], "confidence": 0.6}]},
+      {"frame": 20, "features": [{"type": "point", "a": [[20, 0]], "b": [[21, 1]]}]}]}"#;
+    let mut d = Document::parse(text).unwrap();
+    let at = |d: &Document, t: f64| d.scene().features_at(t)[0].confidence;
+    assert_eq!(at(&d, 5.0), Some(0.6));
+    assert_eq!(at(&d, 15.0), None);
+    d.key_here(5.0).unwrap();
+    let v: Value = serde_json::from_str(&d.text()).unwrap();
+    let key = v["keyframes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|k| k["frame"] == 5)
+        .unwrap();
+    assert_eq!(key["features"][0]["confidence"], 0.6);
+}

@@ -81,6 +81,9 @@ impl Scene {
                 a: lerp_points(&f0.a, &f1.a, w),
                 b: lerp_points(&f0.b, &f1.b, w),
                 closed: f0.closed,
+                // Between two keys the pair is as sure as the less sure
+                // end; one the artist keyed is theirs.
+                confidence: f0.confidence.zip(f1.confidence).map(|(c0, c1)| c0.min(c1)),
             })
             .collect()
     }

@@ -520,6 +520,7 @@ fn feature(raw: RawFeature, index: usize, prefix: &str) -> Result<Feature> {
         a: side(raw.a, "a")?,
         b: side(raw.b, "b")?,
         closed,
+        confidence: raw.confidence,
     })
 }
 

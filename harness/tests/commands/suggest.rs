@@ -456,7 +456,11 @@ fn the_users_features_are_kept_and_suggestions_keep_clear_of_them() {
 fn panned(plate: &Plate, d: Vec2) -> Plate {
     let v = plate.image.view();
     let image = Image::from_fn(v.bounds(), v.channels(), |i, j, c| {
-        sample(&plate.image, Vec2::new(i as f64 + 0.5, j as f64 + 0.5) - d, c)
+        sample(
+            &plate.image,
+            Vec2::new(i as f64 + 0.5, j as f64 + 0.5) - d,
+            c,
+        )
     });
     Plate::new(image, plate.size)
 }
@@ -478,8 +482,13 @@ fn suggestions_on_sequences_are_tracked_through_both() {
     }
     let (sa, sb) = (dir.join("a.####.exr"), dir.join("b.####.exr"));
     let out = dir.join("s.morph.json");
-    let scene = run_suggest(&sa, &sb, &out, &["--frames", "1-5", "--at", "3", "--count", "20"])
-        .expect("suggested and tracked");
+    let scene = run_suggest(
+        &sa,
+        &sb,
+        &out,
+        &["--frames", "1-5", "--at", "3", "--count", "20"],
+    )
+    .expect("suggested and tracked");
     let keys = scene["keyframes"].as_array().unwrap();
     let frames: Vec<f64> = keys.iter().map(|k| k["frame"].as_f64().unwrap()).collect();
     assert_eq!(frames, [1.0, 2.0, 3.0, 4.0, 5.0]);
@@ -497,7 +506,10 @@ fn suggestions_on_sequences_are_tracked_through_both() {
             worst = worst.max(point(&f["b"][0]).distance(*q3 + d));
         }
     }
-    assert!(worst <= 0.5, "a tracked point {worst:.2} px from where the pan put it");
+    assert!(
+        worst <= 0.5,
+        "a tracked point {worst:.2} px from where the pan put it"
+    );
     // The scene in between is gone.
     let left: Vec<_> = std::fs::read_dir(&*dir)
         .unwrap()

@@ -36,12 +36,17 @@ impl Outline {
     }
 
     /// Its label: the slot's number, else the feature's name, else `#n`
-    /// (its place in the scene, from 1).
+    /// (its place in the scene, from 1); a suggestion's confidence after
+    /// it, in percent.
     pub fn label(&self) -> String {
-        match (self.owner, &self.feature.name) {
+        let label = match (self.owner, &self.feature.name) {
             (Owner::Slot(k), _) => k.to_string(),
             (_, Some(name)) => name.clone(),
             (Owner::Shape(i) | Owner::File(i), None) => format!("#{}", i + 1),
+        };
+        match self.feature.confidence {
+            Some(c) => format!("{label} {:.0}%", c * 100.0),
+            None => label,
         }
     }
 

@@ -34,6 +34,17 @@ pub const A_COLOUR: [f32; 3] = [1.0, 0.55, 0.1];
 /// B's features.
 pub const B_COLOUR: [f32; 3] = [0.25, 0.8, 1.0];
 const BETWEEN_COLOUR: [f32; 3] = [0.95, 0.95, 0.95];
+
+/// A suggested pair's colour by its confidence, on both sides until the
+/// artist edits it: red when doubtful, through yellow, to green when sure.
+pub fn confidence_colour(c: f64) -> [f32; 3] {
+    let c = c.clamp(0.0, 1.0) as f32;
+    if c < 0.5 {
+        [1.0, 0.25 + 1.5 * c, 0.2]
+    } else {
+        [1.0 - 1.4 * (c - 0.5), 1.0, 0.2 + 0.2 * (c - 0.5)]
+    }
+}
 const CONNECTOR_COLOUR: [f32; 3] = [0.75, 0.75, 0.75];
 const SHADOW: [f32; 4] = [0.0, 0.0, 0.0, 0.8];
 /// Scene File's features: read-only, so drawn fainter.
@@ -190,6 +201,7 @@ impl Pen<'_> {
                     (true, None) => 1.5,
                 };
                 self.painter.width(width);
+                let colour = o.feature.confidence.map_or(colour, confidence_colour);
                 self.colour(colour, if o.editable() { 1.0 } else { FILE_ALPHA });
                 let chain = o.chain(side);
                 self.shape(o, &chain);
