@@ -281,6 +281,11 @@ impl PixelScale {
     pub fn to_pixel(&self, p: Vec2) -> Vec2 {
         Vec2::new(p.x * self.x, p.y * self.y)
     }
+    /// A position in this scale's pixel units as a canonical one.
+    #[inline]
+    pub fn to_canonical(&self, p: Vec2) -> Vec2 {
+        Vec2::new(p.x / self.x, p.y / self.y)
+    }
     /// Full resolution with square pixels.
     #[inline]
     pub fn is_unit(&self) -> bool {

@@ -517,3 +517,64 @@ fn track_forward_keys_scene_text_shapes_at_every_frame_in_one_write() {
     }
     assert!(worst < 0.3, "worst {worst} px off the true motion");
 }
+
+/// The Morph node's Suggest Features button: pairs between its two sources
+/// at the frame, added to Scene Text after the user's own features (kept
+/// exactly), each where the source truly moved, with its confidence; a
+/// cancel leaves Scene Text as it was.
+#[test]
+fn suggest_features_adds_sure_pairs_to_scene_text_and_cancel_adds_none() {
+    let shift = Vec2::new(3.0, -2.0);
+    let plate = |d: Vec2| {
+        let img = Image::from_fn(morphfx::geom::RectI::from_size(192, 160), 3, |i, j, c| {
+            let p = Vec2::new(i as f64 + 0.5, j as f64 + 0.5) - d;
+            morphfx::testing::texture(p * 1.3)[c]
+        });
+        let frame = morphfx_harness::host::Frame::from_image(&img, "OfxBitDepthFloat", false);
+        Arc::new(common::Still(Arc::new(frame)))
+    };
+    let inst = common::bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    inst.connect("SourceA", plate(Vec2::ZERO)).unwrap();
+    inst.connect("SourceB", plate(shift)).unwrap();
+    let mine = r#"{"format": "morphfx-scene", "version": 1, "features": [
+        {"name": "mine", "type": "point", "a": [[96, 80]], "b": [[99, 78]]}]}"#;
+    inst.set_string("scene_text", mine).unwrap();
+    inst.set_int("suggest_count", 15).unwrap();
+
+    inst.cancel_progress_at(Some(0.2));
+    inst.instance_changed("suggest_features", 0.0).unwrap();
+    inst.cancel_progress_at(None);
+    assert_eq!(
+        inst.string("scene_text").unwrap(),
+        mine,
+        "a cancel adds nothing"
+    );
+
+    inst.instance_changed("suggest_features", 0.0).unwrap();
+    let text = inst.string("scene_text").unwrap();
+    let scene: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let features = scene["features"].as_array().unwrap();
+    assert_eq!(features[0]["name"], "mine");
+    assert!(features[0].get("confidence").is_none());
+    let point = |v: &serde_json::Value| Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
+    let suggested = &features[1..];
+    assert!(
+        (8..=15).contains(&suggested.len()),
+        "{} suggestions",
+        suggested.len()
+    );
+    for f in suggested {
+        let c = f["confidence"].as_f64().unwrap();
+        assert!((0.5..=1.0).contains(&c), "{f}");
+        let (a, b) = (point(&f["a"][0]), point(&f["b"][0]));
+        assert!(b.distance(a + shift) < 0.3, "{f}");
+        assert!(
+            a.distance(Vec2::new(96.0, 80.0)) >= 10.0,
+            "{f} on the user's point"
+        );
+    }
+    let (progress, open) = inst.progress_log();
+    assert!(!open && progress.last() == Some(&1.0), "{progress:?}");
+}

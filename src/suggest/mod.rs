@@ -149,6 +149,17 @@ fn spread_out(mut matched: Vec<Suggestion>, a: &Grey, count: usize, clear: f64) 
     kept
 }
 
+/// A plate's luminance as the matcher should see it: on a log scale, so an
+/// HDR plate's highlights do not drown its shadows' texture (a gain
+/// between the plates becomes an offset, which the match ignores).
+pub fn perceptual(linear: &Grey) -> Grey {
+    let floor = 1.0 / 256.0;
+    Grey::from_fn(linear.bounds, |i, j| {
+        let p = Vec2::new(i as f64 + 0.5, j as f64 + 0.5);
+        (linear.sample(p).max(0.0) + floor).log2()
+    })
+}
+
 /// The longer side, in pixels, the guide's pictures are brought down to:
 /// the least-work search sees a picture's large shapes (a face's outline,
 /// where its eyes are), which is what a guide needs, in well under a

@@ -10,7 +10,7 @@ use morphfx::choice::Choice;
 use morphfx::geom::{RectD, Vec2};
 use morphfx::make_warp::Method;
 use morphfx::scene::Scene;
-use morphfx::suggest::{suggest, work_guide, SuggestSettings, Suggestion};
+use morphfx::suggest::{perceptual, suggest, work_guide, SuggestSettings, Suggestion};
 use morphfx::track::{Grey, TrackSettings};
 use morphfx::warp::auto::WorkImage;
 use serde_json::{json, Value};
@@ -231,16 +231,9 @@ fn check(s: &SuggestSettings) -> Result<(), HostError> {
     Ok(())
 }
 
-/// A plate as the matcher sees it: luminance on a log scale, so an HDR
-/// plate's highlights do not drown its shadows' texture (a gain between the
-/// plates becomes an offset, which the match ignores).
+/// A plate as the matcher sees it.
 fn grey(plate: &Plate) -> Grey {
-    let linear = Grey::from_view(&plate.image.view());
-    let floor = 1.0 / 256.0;
-    Grey::from_fn(linear.bounds, |i, j| {
-        let p = Vec2::new(i as f64 + 0.5, j as f64 + 0.5);
-        (linear.sample(p).max(0.0) + floor).log2()
-    })
+    perceptual(&Grey::from_view(&plate.image.view()))
 }
 
 /// A plate's frame (canonical: its display window from the origin).

@@ -16,6 +16,7 @@ pub mod params;
 mod render;
 mod snap;
 mod state;
+mod suggest;
 mod track;
 mod warp;
 

@@ -8,6 +8,7 @@ use std::sync::{Mutex, OnceLock};
 use morphfx::choice::Choice;
 use morphfx::image::{EdgeMode, Filter};
 use morphfx::make_warp::Method;
+use morphfx::suggest::SuggestSettings;
 use morphfx::warp::auto::grid::MAX_LEVEL;
 use morphfx::warp::auto::Coefficients;
 use morphfx::warp::field::{Evaluation, FieldSettings, LineInterpolation};
@@ -497,6 +498,48 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
     ];
     if !kind.has_auto() {
         t.retain(|p| p.id() != AUTO_GROUP.name() && p.group() != Some(AUTO_GROUP.name()));
+    }
+    if kind.has_b() {
+        // Pairs between two sources: the Morph node's.
+        t.extend([
+            SUGGEST_FEATURES
+                .spec(
+                    "Suggest Features",
+                    "Proposes feature pairs between Source A and Source B at the \
+                    current frame (points at corners of A, found on B and checked both \
+                    ways) and adds them to Scene Text, clear of your own features, each \
+                    drawn in its confidence's colour until you move it. One undo step; \
+                    Cancel leaves Scene Text as it was.",
+                    (),
+                )
+                .in_group(&LINES_GROUP),
+            SUGGEST_COUNT
+                .spec(
+                    "Suggest Count",
+                    "Pairs Suggest Features proposes at most.",
+                    Ints {
+                        default: 40,
+                        min: 1,
+                        max: 1000,
+                    },
+                )
+                .in_group(&LINES_GROUP)
+                .animated(false),
+            MIN_CONFIDENCE
+                .spec(
+                    "Min Confidence",
+                    "Pairs Suggest Features is less sure of than this are left out \
+                    (0: every pair that matched; 1: only the surest).",
+                    Doubles {
+                        default: SuggestSettings::default().min_confidence,
+                        min: 0.0,
+                        max: 1.0,
+                        display: (0.0, 1.0),
+                    },
+                )
+                .in_group(&LINES_GROUP)
+                .animated(false),
+        ]);
     }
     for k in 1..=LINE_SLOTS {
         t.extend(slot_specs(k));
