@@ -169,6 +169,24 @@ fn shapes_json() -> String {
     serde_json::json!({"format": "morphfx-scene", "version": 1, "features": shapes}).to_string()
 }
 
+/// The bundle in a host with overlays and the Draw suite.
+fn overlay_bundle() -> Bundle {
+    let options = HostOptions {
+        overlays: true,
+        draw_suite: true,
+    };
+    Bundle::load_with(&bundle_path(), options).expect("the bundle")
+}
+
+/// A Morph instance in a 1080p project.
+fn morph_1080p(bundle: &Bundle) -> morphfx_harness::host::Instance<'_> {
+    let inst = bundle
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    inst.set_project(W as f64, H as f64);
+    inst
+}
+
 fn bench_overlay(c: &mut Criterion) {
     let text = shapes_json();
     let mut g = c.benchmark_group("overlay_60_shapes_x20_points");
@@ -176,15 +194,8 @@ fn bench_overlay(c: &mut Criterion) {
     g.bench_function("peer_parse_scene_text_json", |bch| {
         bch.iter(|| black_box(serde_json::from_str::<serde_json::Value>(&text).unwrap()))
     });
-    let options = HostOptions {
-        overlays: true,
-        draw_suite: true,
-    };
-    let bundle = Bundle::load_with(&bundle_path(), options).expect("the bundle");
-    let inst = bundle
-        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-        .unwrap();
-    inst.set_project(W as f64, H as f64);
+    let bundle = overlay_bundle();
+    let inst = morph_1080p(&bundle);
     inst.set_string("scene_text", &text).unwrap();
     let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
     // A drag of one control point: each motion edits and writes Scene
@@ -247,15 +258,8 @@ fn value_calls(inst: &morphfx_harness::host::Instance<'_>) -> usize {
 fn bench_overlay_lines(c: &mut Criterion) {
     let lines = lines();
     let (slots, text) = lines.split_at(64);
-    let options = HostOptions {
-        overlays: true,
-        draw_suite: true,
-    };
-    let bundle = Bundle::load_with(&bundle_path(), options).expect("the bundle");
-    let inst = bundle
-        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-        .unwrap();
-    inst.set_project(W as f64, H as f64);
+    let bundle = overlay_bundle();
+    let inst = morph_1080p(&bundle);
     inst.set_int("line_count", 64).unwrap();
     for (k, f) in slots.iter().enumerate() {
         for (side, which) in [(Side::A, "a"), (Side::B, "b")] {

@@ -195,18 +195,7 @@ fn on_a_warped(photo: &str) {
     let pb_unit = dir.join("b-unit.exr");
     io::write(&pb_unit, &warped(&a, 1.0), ExrPrecision::Float).unwrap();
     io::write(&pa, &a, ExrPrecision::Float).unwrap();
-    let run = run_morphfx(&[
-        "suggest",
-        "--a",
-        pa.to_str().unwrap(),
-        "--b",
-        pb.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    let said = String::from_utf8_lossy(&run.stderr);
-    assert!(run.status.success(), "{said}");
-    let scene: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let scene = run_suggest(&pa, &pb, &out, &[]).expect("suggested");
     assert_eq!(scene["method"], "hybrid");
     let found = pairs(&scene);
     let mut errors: Vec<f64> = found
@@ -288,15 +277,7 @@ fn a_blank_plate_gives_no_suggestions_and_writes_nothing() {
     io::write(&pa, &flat, ExrPrecision::Float).unwrap();
     let v = data("venice.exr");
     for (a, b) in [(pa.as_path(), v.as_path()), (pa.as_path(), pa.as_path())] {
-        let run = run_morphfx(&[
-            "suggest",
-            "--a",
-            a.to_str().unwrap(),
-            "--b",
-            b.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+        let run = suggest_run(a, b, &out, &[]);
         let said = String::from_utf8_lossy(&run.stderr);
         assert_eq!(run.status.code(), Some(2), "{said}");
         assert!(said.contains("nothing to suggest"), "{said}");
@@ -304,9 +285,8 @@ fn a_blank_plate_gives_no_suggestions_and_writes_nothing() {
     }
 }
 
-/// `morphfx suggest --a A --b B -o OUT` and more arguments; the scene
-/// written, or the run's stderr.
-fn run_suggest(a: &Path, b: &Path, out: &Path, more: &[&str]) -> Result<Value, String> {
+/// `morphfx suggest --a A --b B -o OUT` and more arguments, run.
+fn suggest_run(a: &Path, b: &Path, out: &Path, more: &[&str]) -> std::process::Output {
     let mut args = vec![
         "suggest",
         "--a",
@@ -317,7 +297,12 @@ fn run_suggest(a: &Path, b: &Path, out: &Path, more: &[&str]) -> Result<Value, S
         out.to_str().unwrap(),
     ];
     args.extend(more);
-    let run = run_morphfx(&args);
+    run_morphfx(&args)
+}
+
+/// [`suggest_run`]'s scene, or its stderr.
+fn run_suggest(a: &Path, b: &Path, out: &Path, more: &[&str]) -> Result<Value, String> {
+    let run = suggest_run(a, b, out, more);
     if !run.status.success() {
         return Err(String::from_utf8_lossy(&run.stderr).into_owned());
     }
@@ -430,21 +415,7 @@ fn the_users_features_are_kept_and_suggestions_keep_clear_of_them() {
         (vec!["--min-confidence", "1.5"], "--min-confidence 1.5"),
         (vec!["--method", "magic"], "--method magic"),
     ] {
-        let run = run_morphfx(
-            &[
-                vec![
-                    "suggest",
-                    "--a",
-                    pa.to_str().unwrap(),
-                    "--b",
-                    pb.to_str().unwrap(),
-                    "-o",
-                    bad_out.to_str().unwrap(),
-                ],
-                more,
-            ]
-            .concat(),
-        );
+        let run = suggest_run(&pa, &pb, &bad_out, &more);
         let err = String::from_utf8_lossy(&run.stderr);
         assert_eq!(run.status.code(), Some(2), "{err}");
         assert!(err.contains(said), "{said}: {err}");
