@@ -123,7 +123,7 @@ fn warp(dir: &Path, plate: &Path, out: &Path) -> (i32, String) {
 /// damaged plate is given to (the others get a good plate). `{bad}` is the
 /// damaged plate, `{good}` a good one, `{out}` the output, `{seq}` a
 /// two-frame sequence whose second frame is the damaged plate.
-const ROLES: [&str; 13] = [
+const ROLES: [&str; 15] = [
     "warp --scene {scene} --input {bad} -o {out}.exr",
     "warp --scene {scene} --input {good} --mask {bad} -o {out}.exr",
     "morph --scene {scene} --a {bad} --b {good} --t 0.5 -o {out}.exr",
@@ -137,6 +137,8 @@ const ROLES: [&str; 13] = [
     "snap --scene {scene} --a {good} --b {bad} -o {out}.json",
     "track --scene {keyed} --a {seq} --frames 1-2 -o {out}.json",
     "track --scene {keyed} --a {goodseq} --b {seq} --frames 1-2 -o {out}.json",
+    "suggest --a {bad} --b {good} -o {out}.json",
+    "suggest --a {good} --b {bad} -o {out}.json",
 ];
 
 const KEYED: &str = r#"{"format": "morphfx-scene", "version": 1,
