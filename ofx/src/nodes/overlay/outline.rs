@@ -36,17 +36,14 @@ impl Outline {
     }
 
     /// Its label: the slot's number, else the feature's name, else `#n`
-    /// (its place in the scene, from 1); a suggestion's confidence after
-    /// it, in percent.
+    /// (its place in the scene, from 1); for a suggestion, its confidence in
+    /// percent (dozens of them share a picture: a name each would bury it).
     pub fn label(&self) -> String {
-        let label = match (self.owner, &self.feature.name) {
-            (Owner::Slot(k), _) => k.to_string(),
-            (_, Some(name)) => name.clone(),
-            (Owner::Shape(i) | Owner::File(i), None) => format!("#{}", i + 1),
-        };
-        match self.feature.confidence {
-            Some(c) => format!("{label} {:.0}%", c * 100.0),
-            None => label,
+        match (self.owner, &self.feature.name, self.feature.confidence) {
+            (Owner::Slot(k), _, _) => k.to_string(),
+            (_, _, Some(c)) => format!("{:.0}%", c * 100.0),
+            (_, Some(name), None) => name.clone(),
+            (Owner::Shape(i) | Owner::File(i), None, None) => format!("#{}", i + 1),
         }
     }
 
