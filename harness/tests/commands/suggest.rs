@@ -489,3 +489,53 @@ fn suggestions_on_sequences_are_tracked_through_both() {
         .collect();
     assert!(left.is_empty(), "{left:?}");
 }
+
+/// Two different subjects, the demo's round face (A) and square one (B):
+/// the eyes are marked by hand (their centres, where `demo_face` draws
+/// them), and every suggestion on an eye of A lands on the same part of
+/// B's eye; each eye gets one.
+#[test]
+fn on_two_different_faces_suggestions_land_eye_on_eye() {
+    use morphfx_harness::commands::demo::demo_face;
+    let dir = scratch("suggest-faces");
+    let (w, h) = (320usize, 240usize);
+    let face = |square: bool| {
+        let image = Image::from_fn(RectI::from_size(w, h), 4, |i, j, c| {
+            demo_face(i, j, c, square, (w, h))
+        });
+        Plate::new(image, (w, h))
+    };
+    let (pa, pb, out) = (
+        dir.join("a.exr"),
+        dir.join("b.exr"),
+        dir.join("s.morph.json"),
+    );
+    io::write(&pa, &face(false), ExrPrecision::Float).unwrap();
+    io::write(&pb, &face(true), ExrPrecision::Float).unwrap();
+    let scene = run_suggest(&pa, &pb, &out, &[]).expect("suggested");
+    // Eye centres by hand: A's at (±30, 25) from the face's centre, B's at
+    // (±35, 35).
+    let centre = Vec2::new(160.0, 120.0);
+    let eyes = [
+        (Vec2::new(-30.0, 25.0), Vec2::new(-35.0, 35.0)),
+        (Vec2::new(30.0, 25.0), Vec2::new(35.0, 35.0)),
+    ]
+    .map(|(a, b)| (centre + a, centre + b));
+    let mut on_eye = [0; 2];
+    for (p, q, _) in pairs(&scene) {
+        for (k, (ea, eb)) in eyes.iter().enumerate() {
+            if p.distance(*ea) <= 12.0 {
+                on_eye[k] += 1;
+                let truth = *eb + (p - *ea);
+                assert!(
+                    q.distance(truth) <= 1.0,
+                    "{p:?} on eye {k} went to {q:?}, not {truth:?}"
+                );
+            }
+        }
+    }
+    assert!(
+        on_eye.iter().all(|&n| n >= 1),
+        "suggestions on the eyes: {on_eye:?}"
+    );
+}
