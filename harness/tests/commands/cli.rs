@@ -22,6 +22,24 @@ fn tmp(name: &str) -> common::Scratch {
     common::scratch(name)
 }
 
+/// `morphfx morph --scene DIR/s.morph.json --a A --b B [MORE] -o OUT`:
+/// exit status and stderr.
+fn morph_in(d: &Path, a: &str, b: &str, more: &[&str], out: &Path) -> (i32, String) {
+    let scene = d.join("s.morph.json");
+    let mut args = vec![
+        "morph",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--a",
+        a,
+        "--b",
+        b,
+    ];
+    args.extend(more);
+    args.extend(["-o", out.to_str().unwrap()]);
+    morphfx(&args)
+}
+
 /// Writes `image` as a float EXR in a `size` display window; returns its path.
 fn write_plate(dir: &Path, name: &str, image: Image, size: (usize, usize)) -> String {
     write_exr(dir, name, &Plate::new(image, size))
@@ -91,19 +109,7 @@ fn morph_at_t0_is_a_and_at_t1_is_b_bit_for_bit() {
     std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
     for (t, src) in [("0", &a), ("1", &b)] {
         let out = d.join(format!("m{t}.exr"));
-        let (code, err) = morphfx(&[
-            "morph",
-            "--scene",
-            d.join("s.morph.json").to_str().unwrap(),
-            "--a",
-            &a,
-            "--b",
-            &b,
-            "--t",
-            t,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+        let (code, err) = morph_in(&d, &a, &b, &["--t", t], &out);
         assert_eq!(code, 0, "{err}");
         assert_eq!(
             io::read(&out).unwrap().image,
@@ -126,17 +132,7 @@ fn bad_scene_exits_2_naming_the_feature_and_writes_nothing() {
     )
     .unwrap();
     let out = d.join("m.exr");
-    let (code, err) = morphfx(&[
-        "morph",
-        "--scene",
-        d.join("s.morph.json").to_str().unwrap(),
-        "--a",
-        &a,
-        "--b",
-        &b,
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (code, err) = morph_in(&d, &a, &b, &[], &out);
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("\"nose\"") && err.contains("a has 2 points but b has 1"),
@@ -154,17 +150,7 @@ fn size_mismatch_and_missing_frames_exit_2() {
     );
     std::fs::write(d.join("s.morph.json"), TRANSLATE).unwrap();
     let out = d.join("m.exr");
-    let (code, err) = morphfx(&[
-        "morph",
-        "--scene",
-        d.join("s.morph.json").to_str().unwrap(),
-        "--a",
-        &a,
-        "--b",
-        &b,
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (code, err) = morph_in(&d, &a, &b, &[], &out);
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("size mismatch") && err.contains("b.exr"),
@@ -376,19 +362,7 @@ fn plates_with_other_data_windows_morph_over_the_union_in_the_display_window() {
       "features": [{"type": "line", "a": [[10, 10], [40, 12]], "b": [[10, 10], [40, 12]]}]}"#;
     std::fs::write(d.join("s.morph.json"), still).unwrap();
     let out = d.join("m.exr");
-    let (code, err) = morphfx(&[
-        "morph",
-        "--scene",
-        d.join("s.morph.json").to_str().unwrap(),
-        "--a",
-        &a,
-        "--b",
-        &b,
-        "--t",
-        "0.5",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (code, err) = morph_in(&d, &a, &b, &["--t", "0.5"], &out);
     assert_eq!(code, 0, "{err}");
     let m = io::read(&out).unwrap();
     assert_eq!(m.size, (64, 48), "the display window is kept");
