@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use morphfx::choice::Choice;
+use morphfx::features::FeatureKind;
 use morphfx::geom::{RectD, Vec2};
 use morphfx::make_warp::Method;
 use morphfx::scene::Scene;
@@ -90,9 +91,12 @@ impl Suggest<'_> {
         let (lo, hi) = found.iter().fold((1.0f64, 0.0f64), |(lo, hi), s| {
             (lo.min(s.confidence), hi.max(s.confidence))
         });
+        let lines = found.iter().filter(|s| s.kind == FeatureKind::Line).count();
         println!(
-            "suggest: {} pair(s), confidence {lo:.2} to {hi:.2} -> {}",
+            "suggest: {} pair(s) ({lines} line(s), {} point(s)), confidence {lo:.2} to {hi:.2} \
+             -> {}",
             found.len(),
+            found.len() - lines,
             self.output.display()
         );
         Ok(())
@@ -187,11 +191,14 @@ impl Suggest<'_> {
         };
         let first = list.len();
         for (k, s) in found.iter().enumerate() {
+            let points = |side: &[Vec2]| -> Vec<[f64; 2]> {
+                side.iter().map(|p| [round(p.x), round(p.y)]).collect()
+            };
             list.push(json!({
                 "name": format!("suggested {}", first + k + 1),
-                "type": "point",
-                "a": [[round(s.a.x), round(s.a.y)]],
-                "b": [[round(s.b.x), round(s.b.y)]],
+                "type": s.kind.name(),
+                "a": points(&s.a),
+                "b": points(&s.b),
                 "confidence": (s.confidence * 1000.0).round() / 1000.0,
             }));
         }

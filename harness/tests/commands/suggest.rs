@@ -85,7 +85,8 @@ fn warped(a: &Plate, gain: f32) -> Plate {
     Plate::new(image, a.size)
 }
 
-/// The suggested pairs of a scene: A point, B point, confidence.
+/// The suggested pairs of a scene, every point of each feature (a line's
+/// two ends): A point, B point, confidence.
 fn pairs(scene: &Value) -> Vec<(Vec2, Vec2, f64)> {
     let point = |v: &Value| Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
     scene["features"]
@@ -93,12 +94,11 @@ fn pairs(scene: &Value) -> Vec<(Vec2, Vec2, f64)> {
         .unwrap()
         .iter()
         .filter(|f| f.get("confidence").is_some())
-        .map(|f| {
-            (
-                point(&f["a"][0]),
-                point(&f["b"][0]),
-                f["confidence"].as_f64().unwrap(),
-            )
+        .flat_map(|f| {
+            let (a, b) = (f["a"].as_array().unwrap(), f["b"].as_array().unwrap());
+            assert_eq!(a.len(), b.len(), "{f}");
+            let c = f["confidence"].as_f64().unwrap();
+            a.iter().zip(b).map(move |(p, q)| (point(p), point(q), c))
         })
         .collect()
 }
@@ -206,9 +206,15 @@ fn on_a_warped(photo: &str) {
     let (median, p95) = (percentile(&errors, 0.5), percentile(&errors, 0.95));
     let points: Vec<Vec2> = found.iter().map(|f| f.0).collect();
     let covered = coverage(&a, &points);
+    let lines = scene["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["type"] == "line")
+        .count();
     eprintln!(
-        "suggest on {photo}: {} pairs, error median {median:.3} px, 95th {p95:.3} px, \
-         coverage {:.0} %",
+        "suggest on {photo}: {} points ({lines} lines), error median {median:.3} px, \
+         95th {p95:.3} px, coverage {:.0} %",
         found.len(),
         covered * 100.0
     );
@@ -262,6 +268,116 @@ fn on_a_warped(photo: &str) {
         g / dissolve
     );
     assert!(g <= 0.5 * dissolve, "ghost {g} against {dissolve}");
+}
+
+/// Boxes `[x0, y0, x1, y1]` pasted on the photograph: a facade's windows,
+/// edges long and straight enough for lines.
+const BOXES: [[f64; 4]; 6] = [
+    [40.0, 40.0, 110.0, 100.0],
+    [150.0, 150.0, 230.0, 210.0],
+    [280.0, 40.0, 340.0, 110.0],
+    [380.0, 140.0, 470.0, 200.0],
+    [60.0, 160.0, 120.0, 220.0],
+    [400.0, 30.0, 470.0, 90.0],
+];
+
+/// On a photograph with boxes pasted on it, under the known warp, the
+/// suggestions include lines along the boxes' sides, end to end (corner
+/// to corner, give or take the corner's rounding at the first halving),
+/// and every line's ends (the photograph's own too) land on B where A's
+/// ends truly went, as closely as the issue asks of points (median 0.5
+/// px; 1.5 px, there the 95th percentile, here the worst).
+#[test]
+fn lines_run_along_straight_edges_and_land_where_they_went() {
+    let dir = scratch("suggest-lines");
+    let photo = display(&io::read(&data("venice.exr")).unwrap());
+    let v = photo.image.view();
+    let image = Image::from_fn(v.bounds(), v.channels(), |i, j, c| {
+        let p = Vec2::new(i as f64 + 0.5, j as f64 + 0.5);
+        let inside = BOXES
+            .iter()
+            .position(|[x0, y0, x1, y1]| (*x0..*x1).contains(&p.x) && (*y0..*y1).contains(&p.y));
+        match inside {
+            Some(k) => [0.85, 0.05][k % 2],
+            None => 0.5 * v.row(j)[i as usize * v.channels() + c],
+        }
+    });
+    let a = Plate::new(image, photo.size);
+    let (pa, pb, out) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("s.json"));
+    io::write(&pa, &a, ExrPrecision::Float).unwrap();
+    io::write(&pb, &warped(&a, 1.2), ExrPrecision::Float).unwrap();
+    let run = suggest_run(&pa, &pb, &out, &[]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let scene: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let point = |v: &Value| Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
+    let lines: Vec<&Value> = scene["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["type"] == "line")
+        .collect();
+    let (mut on_sides, mut errors) = (0, Vec::new());
+    let sides: Vec<(Vec2, Vec2)> = BOXES
+        .iter()
+        .flat_map(|&[x0, y0, x1, y1]| {
+            let c = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)].map(|(x, y)| Vec2::new(x, y));
+            (0..4).map(move |k| (c[k], c[(k + 1) % 4]))
+        })
+        .collect();
+    for f in &lines {
+        let (a0, a1) = (point(&f["a"][0]), point(&f["a"][1]));
+        // Along a side: across it within a pixel, from end to end with
+        // the corners' rounding and the ground's texture beside them.
+        let along = |(p, q): &(Vec2, Vec2)| {
+            let (d, n) = ((*q - *p) * (1.0 / p.distance(*q)), (*q - *p).perp());
+            let across = |x: Vec2| (x - *p).dot(n).abs() / n.length();
+            let t = |x: Vec2| (x - *p).dot(d);
+            let (lo, hi) = (t(a0).min(t(a1)), t(a0).max(t(a1)));
+            across(a0) < 1.0
+                && across(a1) < 1.0
+                && lo.abs() < 6.0
+                && (hi - p.distance(*q)).abs() < 6.0
+        };
+        on_sides += sides.iter().any(along) as usize;
+        for k in 0..2 {
+            let (p, q) = (point(&f["a"][k]), point(&f["b"][k]));
+            errors.push(q.distance(truth(p)));
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let (median, worst) = (percentile(&errors, 0.5), errors[errors.len() - 1]);
+    eprintln!(
+        "lines: {} ({on_sides} along the boxes), ends' error median {median:.3} px, \
+         worst {worst:.3} px",
+        lines.len()
+    );
+    assert!(
+        median <= 0.5 && worst <= 1.5,
+        "median {median}, worst {worst}"
+    );
+    assert!(
+        on_sides >= 4,
+        "{on_sides} of {} lines along the boxes",
+        lines.len()
+    );
+    // At most a quarter of the 40 are lines, each at least three patch
+    // radii long; the command says how many of each it wrote.
+    assert!(lines.len() <= 10, "{} lines", lines.len());
+    for f in &lines {
+        assert!(point(&f["a"][0]).distance(point(&f["a"][1])) >= 36.0, "{f}");
+    }
+    let total = scene["features"].as_array().unwrap().len();
+    let said = String::from_utf8_lossy(&run.stdout);
+    let expected = format!(
+        "suggest: {total} pair(s) ({} line(s), {} point(s)), confidence",
+        lines.len(),
+        total - lines.len()
+    );
+    assert!(said.contains(&expected), "{said}");
 }
 
 /// A blank plate has nothing to match: exit status 2, a message saying so,
@@ -469,12 +585,11 @@ fn suggestions_on_sequences_are_tracked_through_both() {
     let mut worst: f64 = 0.0;
     for (k, key) in keys.iter().enumerate() {
         let d = pan * (k as f64 - 2.0);
-        let features = key["features"].as_array().unwrap();
-        assert_eq!(features.len(), key3.len());
-        for (f, (p3, q3, _)) in features.iter().zip(&key3) {
-            let point = |v: &Value| Vec2::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
-            worst = worst.max(point(&f["a"][0]).distance(*p3 + d));
-            worst = worst.max(point(&f["b"][0]).distance(*q3 + d));
+        let here = at(key);
+        assert_eq!(here.len(), key3.len());
+        for ((p, q, _), (p3, q3, _)) in here.iter().zip(&key3) {
+            worst = worst.max(p.distance(*p3 + d));
+            worst = worst.max(q.distance(*q3 + d));
         }
     }
     assert!(

@@ -87,7 +87,11 @@ pub fn suggest_features(instance: &NodeState, effect: &EffectHandle, time: f64) 
         let f = Feature {
             name: Some(format!("suggested {}", first + k + 1)),
             confidence: Some((s.confidence * 1000.0).round() / 1000.0),
-            ..Feature::point(sa.to_canonical(s.a), sb.to_canonical(s.b))
+            ..Feature::new(
+                s.kind,
+                s.a.iter().map(|p| sa.to_canonical(*p)).collect(),
+                s.b.iter().map(|p| sb.to_canonical(*p)).collect(),
+            )
         };
         doc.add_feature(&f).map_err(shapes::refused)?;
     }
