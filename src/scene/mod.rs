@@ -4,6 +4,8 @@
 pub mod edit;
 #[cfg(test)]
 mod edit_tests;
+#[cfg(test)]
+mod mesh_edit_tests;
 mod parse;
 mod range;
 mod scattered;

@@ -175,6 +175,15 @@ impl Mesh {
     }
 }
 
+/// A node of the mesh: its row (from the bottom) and column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Node {
+    /// Row, 0 at the bottom.
+    pub row: usize,
+    /// Column, 0 at the left.
+    pub col: usize,
+}
+
 /// How a mesh warp is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Pass {

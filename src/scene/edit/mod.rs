@@ -4,11 +4,14 @@
 //! the edit does not touch keeps its value (and keys their order), and the
 //! result is checked as a scene before it is accepted.
 
+mod mesh;
+
 use serde_json::{Map, Value};
 
 use super::Scene;
 use crate::features::{catmull_rom, catmull_rom_closed, Feature, FeatureKind, Side};
 use crate::geom::Vec2;
+use crate::warp::mesh::MeshPair;
 use crate::{Error, Result};
 
 /// Frames closer than this are the same key.
@@ -238,9 +241,13 @@ impl Document {
     }
 
     /// Turns a static scene into one keyed at `frame`, or keys a keyed one
-    /// at `frame` from its interpolated features; nothing moves.
+    /// at `frame` from its interpolated features; the mesh likewise (its
+    /// keys are its own); nothing moves.
     pub fn key_here(&mut self, frame: f64) -> Result<()> {
-        self.edit(|doc| doc.key_at(frame).map(|_| ()))
+        self.edit(|doc| {
+            doc.key_at(frame)?;
+            key_mesh(doc, frame)
+        })
     }
 
     /// Applies `change` to a copy of the JSON and keeps it only if it still
@@ -391,6 +398,53 @@ impl Editor<'_> {
         keys.insert(at, Value::Object(key));
         Ok(at)
     }
+}
+
+/// Keys the mesh at `frame` as [`Document::key_here`] keys the features:
+/// a static mesh becomes one key, a keyed one gains the mesh interpolated
+/// there.
+fn key_mesh(editor: &mut Editor<'_>, frame: f64) -> Result<()> {
+    let Some(pair) = editor.scene.mesh_at(frame) else {
+        return Ok(());
+    };
+    let Some(mesh) = editor.root.get_mut("mesh").and_then(Value::as_object_mut) else {
+        return Ok(());
+    };
+    match mesh.get_mut("keyframes").and_then(Value::as_array_mut) {
+        Some(keys) if !keys.is_empty() => {
+            mesh_key_at(keys, frame, &pair);
+        }
+        _ => {
+            mesh.remove("a");
+            mesh.remove("b");
+            let mut keys = Vec::new();
+            mesh_key_at(&mut keys, frame, &pair);
+            mesh.insert("keyframes".into(), Value::Array(keys));
+        }
+    }
+    Ok(())
+}
+
+/// The index of the mesh key at `frame`, inserted in frame order from
+/// `pair` (the mesh there) when there is none.
+fn mesh_key_at(keys: &mut Vec<Value>, frame: f64, pair: &MeshPair) -> usize {
+    let frame_of = |k: &Value| k.get("frame").and_then(Value::as_f64);
+    if let Some(i) = keys
+        .iter()
+        .position(|k| frame_of(k).is_some_and(|f| (f - frame).abs() < SAME_FRAME))
+    {
+        return i;
+    }
+    let at = keys
+        .iter()
+        .rposition(|k| frame_of(k).is_some_and(|f| f < frame))
+        .map_or(0, |i| i + 1);
+    let mut key = Map::new();
+    key.insert("frame".into(), number(frame));
+    key.insert("a".into(), points_json(pair.a.nodes()));
+    key.insert("b".into(), points_json(pair.b.nodes()));
+    keys.insert(at, Value::Object(key));
+    at
 }
 
 fn keyframes_json(root: &mut Map<String, Value>) -> Result<&mut Vec<Value>> {
