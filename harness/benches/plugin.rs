@@ -6,7 +6,8 @@
 //! The overlay: 60 shapes of 20 points each in Scene Text drawn through
 //! the Draw suite, hovered and dragged, against parsing the same text;
 //! and 100 lines (all 64 line slots, 36 more in Scene Text), hovered and
-//! a slot's line dragged, with the host reads each event makes printed.
+//! a slot's line dragged, with the host reads each event makes printed;
+//! and a 32 × 32 mesh (method mesh) drawn, hovered and a node dragged.
 //!
 //! `cargo xtask bundle --release && cargo bench -p morphfx-harness --features bench --bench plugin`
 
@@ -245,7 +246,8 @@ criterion_group!(
     benches,
     bench_plugin_path,
     bench_overlay,
-    bench_overlay_lines
+    bench_overlay_lines,
+    bench_overlay_grid
 );
 
 /// Host value calls (reads and writes) the instance's params have had.
@@ -287,6 +289,54 @@ fn bench_overlay_lines(c: &mut Criterion) {
     // A drag of slot 1's A start: each motion keys the point.
     let p = slots[0].points(Side::A)[0];
     draw_hover_and_drag(&mut g, &ov, (p.x, p.y));
+    g.finish();
+}
+
+/// A 32 × 32 mesh over the 1080p frame, B's interior nodes a little off
+/// A's, method mesh.
+fn grid_json() -> String {
+    let n = 32;
+    let node = |r: usize, c: usize| {
+        let (x, y) = (W as f64 * c as f64 / 31.0, H as f64 * r as f64 / 31.0);
+        [x, y]
+    };
+    let a: Vec<[f64; 2]> = (0..n)
+        .flat_map(|r| (0..n).map(move |c| node(r, c)))
+        .collect();
+    let b: Vec<[f64; 2]> = (0..n)
+        .flat_map(|r| (0..n).map(move |c| (r, c)))
+        .map(|(r, c)| {
+            let [x, y] = node(r, c);
+            let inner = r > 0 && c > 0 && r + 1 < n && c + 1 < n;
+            if inner {
+                [
+                    x + 5.0 * ((r + c) % 3) as f64,
+                    y - 4.0 * ((r * c) % 2) as f64,
+                ]
+            } else {
+                [x, y]
+            }
+        })
+        .collect();
+    serde_json::json!({"format": "morphfx-scene", "version": 1, "method": "mesh",
+        "mesh": {"rows": n, "cols": n, "a": a, "b": b}})
+    .to_string()
+}
+
+fn bench_overlay_grid(c: &mut Criterion) {
+    let text = grid_json();
+    let mut g = c.benchmark_group("overlay_grid_32x32");
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    g.bench_function("peer_parse_scene_text_json", |bch| {
+        bch.iter(|| black_box(serde_json::from_str::<serde_json::Value>(&text).unwrap()))
+    });
+    let bundle = overlay_bundle();
+    let inst = morph_1080p(&bundle);
+    inst.set_string("scene_text", &text).unwrap();
+    let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
+    // A's node (row 10, col 10).
+    let start = (W as f64 * 10.0 / 31.0, H as f64 * 10.0 / 31.0);
+    draw_hover_and_drag(&mut g, &ov, start);
     g.finish();
 }
 

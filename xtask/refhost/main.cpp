@@ -3,7 +3,8 @@
 // it must support, creates an instance, checks what the spec mandates in
 // that context, asks for identity where the answer is known, and renders
 // every warp method at render scale 1 and 0.5 in float and 8-bit, and
-// drives each node's overlay (draw, and a drag that moves a line; drawn in
+// drives each node's overlay (draw, a drag that moves a line, shapes, a
+// grid made with Reset Grid and a node of it dragged; drawn in
 // an offscreen OpenGL context too, where Mesa's EGL is there). Exit
 // status 0 when every check passed, 1 with the failures listed otherwise.
 #include <unistd.h>
@@ -567,6 +568,49 @@ void checkOverlayShapes(Effect &fx, const Where &w) {
 /// sources do not move from frame to frame, so B's line, which lies on
 /// Source B's checkerboard, must stay where it was keyed (a tracker that
 /// drifted, or keyed at the wrong scale, would move it). A's line lies on a
+/// Grid warps: Grid Rows and Grid Columns at 4, Reset Grid pressed (an
+/// even mesh over Source A, 96 x 64 here), then B's node (row 1, col 1) at
+/// (32, 64/3) dragged through the overlay to (36, 25): Scene Text read
+/// back holds the 4 x 4 mesh, method mesh, and the moved node on B only.
+void checkOverlayGrid(Effect &fx, const Where &w) {
+  auto *text = dynamic_cast<OFX::Host::Param::StringInstance *>(fx.getParam("scene_text"));
+  auto *rows = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("grid_rows"));
+  auto *cols = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("grid_cols"));
+  auto *edit = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("overlay_edit"));
+  if (!text || !rows || !cols || !edit)
+    return fail(w.text + ": no scene_text, grid_rows, grid_cols or overlay_edit param");
+  text->set("{\"format\": \"morphfx-scene\", \"version\": 1, \"features\": []}");
+  rows->set(4);
+  cols->set(4);
+  const OfxPointD scale = {1, 1};
+  expectOk(fx.beginInstanceChangedAction(kOfxChangeUserEdited), w, "beginInstanceChanged");
+  expectOk(fx.paramInstanceChangedAction("reset_grid", kOfxChangeUserEdited, 0, scale), w,
+           "instanceChanged reset_grid");
+  expectOk(fx.endInstanceChangedAction(kOfxChangeUserEdited), w, "endInstanceChanged");
+  std::string after;
+  text->get(after);
+  auto has = [&](const char *s) { return after.find(s) != std::string::npos; };
+  if (!has("\"method\": \"mesh\"") || !has("\"rows\": 4") || !has("\"cols\": 4") ||
+      !has("[96, 64]") || !has("[32, 21.33"))
+    return fail(w.text + ": Reset Grid (4 x 4) left Scene Text " + after);
+  edit->set(2);  // B
+  Overlay ov(fx);
+  expectOk(ov.createInstanceAction(), w, "overlay createInstance");
+  const OfxPointI vp = {0, 0};
+  expectOk(ov.drawAction(0, scale), w, "overlay draw");
+  const OfxPointD from = {32, 64.0 / 3.0}, mid = {34, 23}, to = {36, 25};
+  expectOk(ov.penDownAction(0, scale, from, vp, 1), w, "overlay pen down on a node");
+  expectOk(ov.penMotionAction(0, scale, mid, vp, 1), w, "overlay pen motion");
+  expectOk(ov.penUpAction(0, scale, to, vp, 0), w, "overlay pen up");
+  edit->set(0);
+  text->get(after);
+  const std::size_t b = after.find("\"b\"");
+  const bool moved = b != std::string::npos && after.find("[36, 25", b) != std::string::npos;
+  const bool a_kept = after.find("[36, 25") > b;
+  if (!moved || !a_kept)
+    fail(w.text + ": dragging B's node (1, 1) to (36, 25) left Scene Text " + after);
+}
+
 /// plain ramp, where the tracker may rightly report it lost (a warning).
 void checkTrack(Effect &fx, const Where &w) {
   auto *b = dynamic_cast<OFX::Host::Param::Double2DInstance *>(fx.getParam("line1_b_start"));
@@ -742,6 +786,7 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
     checkOverlay(*fx, w.with("overlay"));
     checkOverlayGl(*fx, w.with("overlay in OpenGL"));
     checkOverlayShapes(*fx, w.with("overlay shapes"));
+    checkOverlayGrid(*fx, w.with("overlay grid"));
     loadScene(*fx, w);
     if (inputClips(*fx).size() == 2) checkTrack(*fx, w.with("track"));
     checkMattes(*fx, w.with("mattes"));

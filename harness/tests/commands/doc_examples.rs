@@ -72,7 +72,8 @@ fn the_parser_finds_commands_and_joins_their_lines() {
 
 /// What the commands name: the demo's output, the face scene (its shapes
 /// keyed once at 1001, progress over 1001-1048), single plates and 48-frame
-/// sequences of them, the bend scene and the real photograph it bends.
+/// sequences of them, the face grid, the bend scene and the real
+/// photograph it bends.
 fn prepare(dir: &Path, run: &dyn Fn(&[&str])) {
     run(&["demo", "-o", "morphfx-demo"]);
     let plates = dir.join("morphfx-demo/plates");
@@ -101,8 +102,10 @@ fn prepare(dir: &Path, run: &dyn Fn(&[&str])) {
     .unwrap();
     std::fs::create_dir_all(dir.join("docs/examples")).unwrap();
     std::fs::copy(&shapes, dir.join("docs/examples/face-shapes.morph.json")).unwrap();
-    let bend = "docs/examples/bend.morph.json";
-    std::fs::copy(root().join(bend), dir.join(bend)).unwrap();
+    for example in ["bend", "face-grid"] {
+        let path = format!("docs/examples/{example}.morph.json");
+        std::fs::copy(root().join(&path), dir.join(&path)).unwrap();
+    }
     // The real photograph the user guide's suggestions are shown on.
     let venice = "harness/tests/data/venice.exr";
     std::fs::create_dir_all(dir.join("harness/tests/data")).unwrap();

@@ -10,7 +10,7 @@ use morphfx::geom::RectD;
 
 use super::kind::{NodeKind, MASK_CLIP, OUTPUT_CLIP, TIMING_CLIP, VERSION};
 use super::state::NodeState;
-use super::{lines, overlay, params, render, snap, suggest, track};
+use super::{grid, lines, overlay, params, render, snap, suggest, track};
 use ofx_layer::clips::EffectHandle;
 use ofx_layer::paint::Painter;
 use ofx_layer::params::Params;
@@ -180,6 +180,8 @@ fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) 
         overlay::shapes::copy_scene(node, effect, time)
     } else if change.is(&params::SUGGEST_FEATURES) {
         suggest::suggest_features(node, effect, time)
+    } else if change.is(&params::RESET_GRID) {
+        grid::reset_grid(node, effect, time)
     } else if change.is(&params::LINE_COUNT) {
         lines::hide_unused(node.kind, node.params(), time);
         Ok(())

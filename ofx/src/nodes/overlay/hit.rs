@@ -5,6 +5,7 @@
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
 
+use super::grid::{self, Grid};
 use super::outline::{per_span, Outline};
 use super::state::{Handle, Part};
 
@@ -12,10 +13,18 @@ use super::state::{Handle, Part};
 pub const RADIUS_PX: f64 = 8.0;
 
 /// The handle nearest `pen` within [`RADIUS_PX`] among `sides` of the
-/// editable `outlines`: points before bodies (a point sits on its body),
-/// nearer before farther, and on a tie the first side listed.
-pub fn hit(outlines: &[Outline], pen: Vec2, pixel: (f64, f64), sides: &[Side]) -> Option<Handle> {
+/// editable `outlines` and the grid's nodes: points and nodes before
+/// bodies (a point sits on its body), nearer before farther, and on a tie
+/// the first side listed.
+pub fn hit(
+    outlines: &[Outline],
+    grid: Option<&Grid>,
+    pen: Vec2,
+    pixel: (f64, f64),
+    sides: &[Side],
+) -> Option<Handle> {
     let screen = |p: Vec2| Vec2::new(p.x / pixel.0, p.y / pixel.1);
+    let pen_at = pen;
     let pen = screen(pen);
     let mut best: Option<(u8, f64, Handle)> = None;
     let mut consider = |rank: u8, dist: f64, handle: Handle| {
@@ -41,6 +50,9 @@ pub fn hit(outlines: &[Outline], pen: Vec2, pixel: (f64, f64), sides: &[Side]) -
                 consider(1, dist, handle(Part::Body { span, s }));
             }
         }
+    }
+    if let Some((dist, handle)) = grid.and_then(|g| grid::nearest(g, pen_at, pixel, sides)) {
+        consider(0, dist, handle);
     }
     best.map(|(_, _, h)| h)
 }
@@ -92,18 +104,21 @@ mod tests {
     fn points_win_over_bodies_and_sides_are_kept_apart() {
         let s = [slot()];
         let both = [Side::A, Side::B];
-        let h = hit(&s, Vec2::new(103.0, 101.0), (1.0, 1.0), &both).unwrap();
+        let h = hit(&s, None, Vec2::new(103.0, 101.0), (1.0, 1.0), &both).unwrap();
         assert_eq!(
             (h.owner, h.side, h.part),
             (Owner::Slot(3), Side::A, Part::Point(0))
         );
-        let h = hit(&s, Vec2::new(150.0, 296.0), (1.0, 1.0), &both).unwrap();
+        let h = hit(&s, None, Vec2::new(150.0, 296.0), (1.0, 1.0), &both).unwrap();
         assert_eq!((h.side, h.part), (Side::B, Part::Body { span: 0, s: 0.5 }));
         assert_eq!(
-            hit(&s, Vec2::new(150.0, 296.0), (1.0, 1.0), &[Side::A]),
+            hit(&s, None, Vec2::new(150.0, 296.0), (1.0, 1.0), &[Side::A]),
             None
         );
-        assert_eq!(hit(&s, Vec2::new(150.0, 200.0), (1.0, 1.0), &both), None);
+        assert_eq!(
+            hit(&s, None, Vec2::new(150.0, 200.0), (1.0, 1.0), &both),
+            None
+        );
     }
 
     #[test]
@@ -112,12 +127,12 @@ mod tests {
         // 20 canonical units right of A's end: 20 screen pixels at (1, 1),
         // 5 at (4, 4) (zoomed out: one screen pixel covers four).
         let pen = Vec2::new(220.0, 100.0);
-        assert_eq!(hit(&s, pen, (1.0, 1.0), &[Side::A]), None);
-        let h = hit(&s, pen, (4.0, 4.0), &[Side::A]).unwrap();
+        assert_eq!(hit(&s, None, pen, (1.0, 1.0), &[Side::A]), None);
+        let h = hit(&s, None, pen, (4.0, 4.0), &[Side::A]).unwrap();
         assert_eq!(h.part, Part::Point(1));
         // Anamorphic (2, 1): x distances halve, y ones do not.
-        assert!(hit(&s, Vec2::new(212.0, 100.0), (2.0, 1.0), &[Side::A]).is_some());
-        assert!(hit(&s, Vec2::new(200.0, 112.0), (2.0, 1.0), &[Side::A]).is_none());
+        assert!(hit(&s, None, Vec2::new(212.0, 100.0), (2.0, 1.0), &[Side::A]).is_some());
+        assert!(hit(&s, None, Vec2::new(200.0, 112.0), (2.0, 1.0), &[Side::A]).is_none());
     }
 
     #[test]
@@ -130,10 +145,20 @@ mod tests {
             feature: Feature::new(FeatureKind::Polyline, sq.clone(), sq).closed(true),
         };
         // On the closing side x = 0, a quarter of the way from (0, 100) down.
-        let h = hit(&[o.clone()], Vec2::new(1.0, 75.0), (1.0, 1.0), &[Side::A]).unwrap();
+        let h = hit(
+            &[o.clone()],
+            None,
+            Vec2::new(1.0, 75.0),
+            (1.0, 1.0),
+            &[Side::A],
+        )
+        .unwrap();
         assert_eq!(h.part, Part::Body { span: 3, s: 0.25 });
         // File features are never grabbed.
         o.owner = Owner::File(0);
-        assert_eq!(hit(&[o], Vec2::new(0.0, 0.0), (1.0, 1.0), &[Side::A]), None);
+        assert_eq!(
+            hit(&[o], None, Vec2::new(0.0, 0.0), (1.0, 1.0), &[Side::A]),
+            None
+        );
     }
 }

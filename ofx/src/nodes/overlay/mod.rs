@@ -2,9 +2,11 @@
 //! Scene Text's shapes, Scene File's features dimmer) with directions,
 //! names, connectors and in-between shapes, and edited with the pen: drag
 //! a point or a whole feature, draw lines, points, polylines and curves,
-//! insert and delete points. The OpenFX layer turns interact actions into these
+//! insert and delete points. With method mesh, the scene's grids too, their
+//! nodes dragged no further than the grid stays unfolded. The OpenFX layer turns interact actions into these
 //! calls; `pen` holds what the pen does, `shapes` the Scene Text edits.
 
+mod grid;
 mod hit;
 mod outline;
 pub mod paint;
@@ -18,7 +20,8 @@ pub use state::State;
 pub use view::draw;
 
 use crate::nodes::params::{
-    slot_ids, DRAW_TOOL, LINE_COUNT, LINE_SLOTS, OVERLAY_EDIT, OVERLAY_SHOW, SCENE_FILE, SCENE_TEXT,
+    slot_ids, DRAW_TOOL, LINE_COUNT, LINE_SLOTS, METHOD, OVERLAY_EDIT, OVERLAY_SHOW, SCENE_FILE,
+    SCENE_TEXT,
 };
 use crate::nodes::state::NodeState;
 use ofx_layer::clips::EffectHandle;
@@ -34,6 +37,7 @@ pub fn slave_params() -> Vec<String> {
         DRAW_TOOL.name(),
         SCENE_TEXT.name(),
         SCENE_FILE.name(),
+        METHOD.name(),
     ]
     .iter()
     .map(|s| s.to_string())

@@ -44,6 +44,7 @@ impl Outline {
             (_, _, Some(c)) => format!("{:.0}%", c * 100.0),
             (_, Some(name), None) => name.clone(),
             (Owner::Shape(i) | Owner::File(i), None, None) => format!("#{}", i + 1),
+            (Owner::Grid, None, None) => "grid".into(),
         }
     }
 

@@ -3,7 +3,9 @@
 
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
+use morphfx::warp::mesh::Mesh;
 
+use super::grid::{self, Grid};
 use super::outline::{per_span, Outline};
 use super::state::{Handle, Owner, Part};
 use crate::nodes::params::Show;
@@ -27,6 +29,8 @@ pub struct Frame<'a> {
     /// The control points of a polyline or curve being drawn, and where
     /// the pen is (the next point's rubber band runs there).
     pub building: (&'a [Vec2], Option<Vec2>),
+    /// The scene's mesh, when the method is mesh.
+    pub grid: Option<&'a Grid>,
 }
 
 /// A's features.
@@ -76,6 +80,7 @@ pub fn paint(p: &mut dyn Painter, frame: &Frame<'_>) {
             shadow,
             pixel: frame.pixel,
         };
+        pen.grid(frame);
         pen.connectors(frame);
         pen.between(frame);
         pen.features(frame);
@@ -151,6 +156,49 @@ impl Pen<'_> {
         };
         let at = self.at(at + self.screen(-LABEL_GAP_PX * 2.0, dy));
         self.painter.text(at, text);
+    }
+
+    /// The mesh: the in-between grid dashed, then each side's rows and
+    /// columns (Scene File's fainter) with its nodes marked where the pen
+    /// may grab them, the hovered node heavier.
+    fn grid(&mut self, frame: &Frame<'_>) {
+        let Some(g) = frame.grid else { return };
+        if matches!(frame.show, Show::Both | Show::Between) {
+            self.painter.stipple(Stipple::Dash);
+            self.painter.width(1.0);
+            self.colour(BETWEEN_COLOUR, 0.6);
+            self.grid_lines(&g.between);
+        }
+        self.painter.stipple(Stipple::Solid);
+        for (side, colour) in sides(frame.show) {
+            self.painter.width(1.0);
+            self.colour(colour, if g.editable { 0.8 } else { FILE_ALPHA });
+            let mesh = g.side(side);
+            self.grid_lines(mesh);
+            if !g.editable {
+                continue;
+            }
+            let marks: Vec<Vec2> = mesh
+                .nodes()
+                .iter()
+                .flat_map(|p| self.square(*p, POINT_PX))
+                .collect();
+            self.painter.lines(&marks);
+            let hovered = frame
+                .hover
+                .filter(|h| h.owner == Owner::Grid && h.side == side);
+            if let Some(h) = hovered {
+                self.painter.width(2.0);
+                self.handle(mesh.nodes(), h.part);
+            }
+        }
+    }
+
+    fn grid_lines(&mut self, mesh: &Mesh) {
+        for line in grid::lines(mesh) {
+            let pts: Vec<Vec2> = line.iter().map(|p| self.at(*p)).collect();
+            self.painter.strip(&pts);
+        }
     }
 
     /// Thin connectors from A's control points to B's.
@@ -283,8 +331,13 @@ impl Pen<'_> {
             .outlines
             .iter()
             .filter(|o| matches!(o.owner, Owner::Shape(_)));
+        let nodes = frame
+            .grid
+            .filter(|g| g.editable)
+            .map(|g| g.pair.a.nodes().iter().chain(g.pair.b.nodes()));
         let corner = shapes
             .flat_map(|o| o.feature.a.iter().chain(&o.feature.b))
+            .chain(nodes.into_iter().flatten())
             .fold(None, |m: Option<Vec2>, p| {
                 Some(m.map_or(*p, |m| Vec2::new(m.x.min(p.x), m.y.min(p.y))))
             });

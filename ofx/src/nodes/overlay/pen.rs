@@ -1,6 +1,6 @@
 //! What the pen does in the viewer: grab and drag a point or a whole
-//! feature, draw a line, a point, a polyline or a curve, insert a point on
-//! a shape, delete with Delete or Backspace. Every edit is one undo step
+//! feature or a grid node, draw a line, a point, a polyline or a curve,
+//! insert a point on a shape, delete with Delete or Backspace. Every edit is one undo step
 //! (an edit block from pen down to pen up), and a drag writes its param
 //! (a slot's end, or Scene Text) once per pen event.
 
@@ -9,9 +9,10 @@ use morphfx::geom::Vec2;
 
 use super::hit;
 
+use super::grid::node_at;
 use super::shapes::{self, refused};
 use super::state::{editable, pixel_of, Building, Drag, Handle, Owner, Part};
-use super::view::outlines;
+use super::view::grabbable;
 use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
 use crate::nodes::params::{OVERLAY_EDIT, OVERLAY_SHOW};
@@ -36,8 +37,14 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
     let (handle, sides) = {
         let state = instance.overlay.locked();
         let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
-        let outlines = outlines(instance, &r, pen.time);
-        let handle = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
+        let (outlines, grid) = grabbable(instance, &r, pen.time);
+        let handle = hit::hit(
+            &outlines,
+            grid.as_ref(),
+            pen.at,
+            pixel_of(&state, &pen),
+            &sides,
+        );
         (handle.map(|h| (h, outlines)), sides)
     };
     if sides.is_empty() {
@@ -54,6 +61,10 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
                 start_slot_drag(instance, h, slot, ends, pen)?
             }
             Owner::Shape(feature) => match grab_shape(instance, h, feature, tool, pen) {
+                Ok(drag) => drag,
+                Err(why) => return refuse(instance, effect, why),
+            },
+            Owner::Grid => match grab_grid(instance, h, pen) {
                 Ok(drag) => drag,
                 Err(why) => return refuse(instance, effect, why),
             },
@@ -174,6 +185,26 @@ fn grab_shape(
     })
 }
 
+/// Grabs a node of Scene Text's mesh, opening the drag's edit block.
+fn grab_grid(instance: &NodeState, h: Handle, pen: Pen) -> Outcome<Drag> {
+    let doc = shapes::document(instance, pen.time)?;
+    let Part::Point(i) = h.part else {
+        return Err(Failure::BadInput("a grid is grabbed by its nodes".into()));
+    };
+    let cols = doc
+        .scene()
+        .mesh_at(pen.time)
+        .map(|m| m.a.cols())
+        .ok_or_else(|| Failure::BadInput("Scene Text has no mesh".into()))?;
+    instance.params().begin_edit("Move Grid Node")?;
+    Ok(Drag::Grid {
+        side: h.side,
+        nodes: vec![node_at(i, cols)],
+        from: pen.at,
+        before: Box::new(doc),
+    })
+}
+
 /// The point tool: a point feature at the pen, dragged until pen up.
 fn new_point(instance: &NodeState, pen: Pen) -> Outcome<Drag> {
     let mut doc = shapes::document(instance, pen.time)?;
@@ -220,6 +251,18 @@ fn write_drag(instance: &NodeState, drag: &Drag, pen: Pen) -> Outcome {
             }
             Ok(())
         }
+        Drag::Grid {
+            side,
+            nodes,
+            from,
+            before,
+        } => {
+            // The fold guard: the nodes stop where the grid would fold.
+            let mut doc = (**before).clone();
+            doc.drag_nodes(pen.time, *side, nodes, pen.at - *from)
+                .map_err(refused)?;
+            shapes::write(instance, &doc)
+        }
         Drag::Shape {
             feature,
             side,
@@ -259,8 +302,14 @@ pub fn motion(
     let r = Reader::new(instance.params(), instance.kind, pen.time);
     let mut state = instance.overlay.locked();
     let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
-    let outlines = outlines(instance, &r, pen.time);
-    let hover = hit::hit(&outlines, pen.at, pixel_of(&state, &pen), &sides);
+    let (outlines, grid) = grabbable(instance, &r, pen.time);
+    let hover = hit::hit(
+        &outlines,
+        grid.as_ref(),
+        pen.at,
+        pixel_of(&state, &pen),
+        &sides,
+    );
     // While a shape is drawn, every motion moves its rubber band.
     let building = match state.building.as_mut() {
         Some(b) => {
@@ -428,7 +477,8 @@ fn end_building(
 /// Key down: modifiers narrow what the pen grabs (and stay the host's
 /// too); Return ends a shape being drawn, Escape drops its unwritten first
 /// point; Delete or Backspace deletes the hovered point (a slot's whole
-/// line, or a shape left too short) or, over a body, the feature.
+/// line, or a shape left too short) or, over a body, the feature; over a
+/// grid node, puts it back where the other side has it.
 pub fn key_down(
     instance: &NodeState,
     effect: &EffectHandle,
@@ -474,7 +524,18 @@ pub fn key_down(
             instance.overlay.locked().selected = None;
             shapes::settle(instance, effect, result)?;
         }
-        (Owner::File(_), _) => return Ok(Reply::Default),
+        (Owner::Grid, Part::Point(i)) => {
+            let result = shapes::document(instance, time).and_then(|mut doc| {
+                let cols = doc.scene().mesh_at(time).map_or(1, |m| m.a.cols());
+                doc.reset_nodes(time, handle.side, &[node_at(i, cols)])
+                    .map_err(refused)?;
+                instance
+                    .params()
+                    .edit_block("Reset Grid Node", || shapes::write(instance, &doc))
+            });
+            shapes::settle(instance, effect, result)?;
+        }
+        (Owner::File(_) | Owner::Grid, _) => return Ok(Reply::Default),
     }
     Ok(Reply::Done)
 }

@@ -5,6 +5,7 @@
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
 use morphfx::scene::edit::Document;
+use morphfx::warp::mesh::Node;
 
 use crate::nodes::params::{EditSides, Show};
 use ofx_layer::plugin::Pen;
@@ -18,6 +19,9 @@ pub enum Owner {
     Shape(usize),
     /// Feature `i` of Scene File: drawn, never edited.
     File(usize),
+    /// Scene Text's mesh (a handle's point is a node, row-major from the
+    /// bottom row).
+    Grid,
 }
 
 /// Which part of a feature the pen holds.
@@ -73,6 +77,15 @@ pub(super) enum Drag {
         slot: usize,
         start: Vec2,
         count_before: i32,
+    },
+    /// Moving Scene Text's mesh nodes `nodes` on `side` by the pen's
+    /// motion since `from`; each event edits `before` afresh, no further
+    /// than the grid stays unfolded.
+    Grid {
+        side: Side,
+        nodes: Vec<Node>,
+        from: Vec2,
+        before: Box<Document>,
     },
     /// Moving Scene Text's feature `feature` on `side`: one point, or all of
     /// them by the pen's motion. Each event edits `before` afresh, so only

@@ -3,16 +3,18 @@
 use std::sync::Arc;
 
 use morphfx::geom::Vec2;
+use morphfx::make_warp::Method;
 use morphfx::scene::Scene;
 use morphfx::warp::field::FieldSettings;
 
+use super::grid::Grid;
 use super::outline::{self, Outline};
 use super::paint::{self, Frame};
 use super::state::Owner;
 use crate::nodes::inputs::{load_scene, progress_at, scene_settings};
 use crate::nodes::lines::slot_lines;
 use crate::nodes::params::{
-    field_settings, Reader, Show, OVERLAY_SHOW, PROGRESS, SCENE_FILE, SCENE_TEXT,
+    field_settings, Reader, Show, METHOD, OVERLAY_SHOW, PROGRESS, SCENE_FILE, SCENE_TEXT,
     SETTINGS_FROM_SCENE, USE_SCENE_PROGRESS,
 };
 use crate::nodes::state::NodeState;
@@ -22,11 +24,22 @@ use ofx_layer::sync::Locked;
 use ofx_layer::{Outcome, Reply};
 
 /// What the pen can grab at `time`: every line slot and every feature of
-/// the scene, at their A and B positions. It reads only the params that
-/// place them (Scene File, Scene Text, Line Count and the used slots). A
-/// scene that does not parse gives no features (the slots still count).
-pub(super) fn outlines(instance: &NodeState, r: &Reader<'_>, time: f64) -> Vec<Outline> {
-    outlines_and_scene(instance, r, time).0
+/// the scene, at their A and B positions, and Scene Text's grid when the
+/// method is mesh. It reads only the params that place them (Scene File,
+/// Scene Text, Line Count and the used slots; the method only when the
+/// scene has a mesh). A scene that does not parse gives no features (the
+/// slots still count).
+pub(super) fn grabbable(
+    instance: &NodeState,
+    r: &Reader<'_>,
+    time: f64,
+) -> (Vec<Outline>, Option<Grid>) {
+    let (outlines, scene) = outlines_and_scene(instance, r, time);
+    let grid = match &scene {
+        Some((s, false)) => grid_of(instance, r, (s, false), 0.0, time),
+        _ => None,
+    };
+    (outlines, grid)
 }
 
 /// The outlines, and the scene they came from with whether it is Scene
@@ -58,14 +71,41 @@ fn outlines_and_scene(
     (outlines, scene.map(|s| (s, from_file)))
 }
 
+/// The scene's mesh at `time` as the overlay shows it, with the grid in
+/// between at `t`, when the method (the scene's where the node takes its
+/// settings from it, else the node's) is mesh.
+fn grid_of(
+    instance: &NodeState,
+    r: &Reader<'_>,
+    (scene, from_file): (&Scene, bool),
+    t: f64,
+    time: f64,
+) -> Option<Grid> {
+    let pair = scene.mesh_at(time)?;
+    let from_scene = scene_settings(Some(scene), r.bool(&SETTINGS_FROM_SCENE), time);
+    let method = from_scene.map_or_else(
+        || r.pick(&METHOD, instance.kind.methods),
+        |w| w.settings.method,
+    );
+    if method != Method::Mesh {
+        return None;
+    }
+    Some(Grid {
+        between: pair.at(t),
+        pair,
+        editable: !from_file,
+    })
+}
+
 /// What the overlay draws at `time`: the outlines, the progress their
 /// in-between shapes are drawn at, the line interpolation those follow,
-/// and the frames Scene Text's shapes are keyed at.
+/// the frames Scene Text's shapes are keyed at, and the mesh.
 struct View {
     outlines: Vec<Outline>,
     t: f64,
     field: FieldSettings,
     keys: Vec<f64>,
+    grid: Option<Grid>,
 }
 
 fn view(instance: &NodeState, r: &Reader<'_>, time: f64) -> View {
@@ -75,15 +115,28 @@ fn view(instance: &NodeState, r: &Reader<'_>, time: f64) -> View {
     let t = progress_at(instance, loaded, node, time).unwrap_or(node.0);
     let from_scene = scene_settings(loaded, r.bool(&SETTINGS_FROM_SCENE), time);
     let field = from_scene.map_or_else(|| field_settings(r), |w| w.settings.field);
-    let keys = match &scene {
+    let mut keys: Vec<f64> = match &scene {
         Some((s, false)) => s.keyframes.iter().map(|k| k.frame).collect(),
         _ => Vec::new(),
     };
+    let grid = scene
+        .as_ref()
+        .and_then(|(s, file)| grid_of(instance, r, (s, *file), t, time));
+    // A keyed mesh's keys are its own (a drag keys only the mesh); one
+    // key alone is where Key Shapes Here keyed the features as well.
+    if let (Some(_), Some((s, false))) = (&grid, &scene) {
+        if s.meshes.len() > 1 {
+            keys.extend(s.meshes.iter().map(|m| m.0));
+            keys.sort_by(f64::total_cmp);
+            keys.dedup_by(|x, y| (*x - *y).abs() < 1e-6);
+        }
+    }
     View {
         outlines,
         t,
         field,
         keys,
+        grid,
     }
 }
 
@@ -125,6 +178,7 @@ pub fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) ->
             pixel,
             keys: (&v.keys, time),
             building: (&building.0, building.1),
+            grid: v.grid.as_ref(),
         },
     );
     Ok(Reply::Done)

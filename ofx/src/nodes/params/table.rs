@@ -12,7 +12,7 @@ use morphfx::suggest::SuggestSettings;
 use morphfx::warp::auto::grid::MAX_LEVEL;
 use morphfx::warp::auto::Coefficients;
 use morphfx::warp::field::{Evaluation, FieldSettings, LineInterpolation};
-use morphfx::warp::mesh::Pass;
+use morphfx::warp::mesh::{Pass, MAX_SIZE};
 use morphfx::warp::mffd::MffdSettings;
 use morphfx::warp::thin_plate::ThinPlateSettings;
 
@@ -179,6 +179,41 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
             )
             .in_group(&MESH_GROUP)
             .animated(false),
+        GRID_ROWS
+            .spec(
+                "Grid Rows",
+                "Rows of nodes Reset Grid makes (a row runs left to right).",
+                Ints {
+                    default: 5,
+                    min: 2,
+                    max: MAX_SIZE as i32,
+                },
+            )
+            .in_group(&MESH_GROUP)
+            .animated(false),
+        GRID_COLS
+            .spec(
+                "Grid Columns",
+                "Columns of nodes Reset Grid makes.",
+                Ints {
+                    default: 5,
+                    min: 2,
+                    max: MAX_SIZE as i32,
+                },
+            )
+            .in_group(&MESH_GROUP)
+            .animated(false),
+        RESET_GRID
+            .spec(
+                "Reset Grid",
+                "Writes an even grid of Grid Rows × Grid Columns nodes over Source \
+            A (the project when nothing is connected) into Scene Text, the same \
+            on A and B, and sets the scene's method to mesh; your features stay. \
+            Then drag its nodes in the viewer (Method: mesh shows the grid). One \
+            undo step.",
+                (),
+            )
+            .in_group(&MESH_GROUP),
         AUTO_GROUP.spec(
             "Auto",
             "Automatic correspondence by work minimisation (method auto)",
@@ -506,8 +541,8 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
                 .spec(
                     "Suggest Features",
                     "Proposes feature pairs between Source A and Source B at the \
-                    current frame (points at corners of A, found on B and checked both \
-                    ways) and adds them to Scene Text, clear of your own features, each \
+                    current frame (lines along A's straight edges and points at its \
+                    corners, found on B and checked both ways) and adds them to Scene Text, clear of your own features, each \
                     drawn in its confidence's colour until you move it. One undo step; \
                     Cancel leaves Scene Text as it was.",
                     (),
