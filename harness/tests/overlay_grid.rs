@@ -122,12 +122,20 @@ fn reset_grid_writes_an_even_grid_over_source_a_and_keeps_the_features() {
     assert_eq!(s.features.len(), 1);
     assert_eq!(s.settings.method, morphfx::make_warp::Method::Mesh);
 
+    // Nothing connected, and the node's own settings in use (its Method
+    // field): the grid covers the project, and the node's Method becomes
+    // mesh, so the viewer shows the grid (its 5 rows and 5 columns on B).
     let bare = morph();
     bare.set_project(400.0, 300.0);
+    bare.set_int("settings_from_scene", 0).unwrap();
+    bare.set_choice("method", "field").unwrap();
     bare.instance_changed("reset_grid", 0.0).unwrap();
     let pair = scene(&bare).mesh_at(0.0).unwrap();
     assert_eq!((pair.a.rows(), pair.a.cols()), (5, 5));
     assert_eq!(pair.a.node(4, 4), v(400.0, 300.0));
+    let ov = common::overlay(&bare);
+    let drawn = strips_in(&ov.draw(0.0, PX).unwrap(), B_COLOUR);
+    assert_eq!(drawn.len(), 10, "{drawn:?}");
     assert!(take_violations().is_empty());
 }
 

@@ -569,7 +569,8 @@ void checkOverlayShapes(Effect &fx, const Where &w) {
 /// Source B's checkerboard, must stay where it was keyed (a tracker that
 /// drifted, or keyed at the wrong scale, would move it). A's line lies on a
 /// Grid warps: Grid Rows and Grid Columns at 4, Reset Grid pressed (an
-/// even mesh over Source A, 96 x 64 here), then B's node (row 1, col 1) at
+/// even mesh over Source A, 96 x 64 here; the node's Method becomes mesh,
+/// as Settings From Scene is off), then B's node (row 1, col 1) at
 /// (32, 64/3) dragged through the overlay to (36, 25): Scene Text read
 /// back holds the 4 x 4 mesh, method mesh, and the moved node on B only.
 void checkOverlayGrid(Effect &fx, const Where &w) {
@@ -577,8 +578,13 @@ void checkOverlayGrid(Effect &fx, const Where &w) {
   auto *rows = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("grid_rows"));
   auto *cols = dynamic_cast<OFX::Host::Param::IntegerInstance *>(fx.getParam("grid_cols"));
   auto *edit = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("overlay_edit"));
-  if (!text || !rows || !cols || !edit)
-    return fail(w.text + ": no scene_text, grid_rows, grid_cols or overlay_edit param");
+  auto *method = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("method"));
+  if (!text || !rows || !cols || !edit || !method)
+    return fail(w.text + ": no scene_text, grid_rows, grid_cols, overlay_edit or method param");
+  // Reset Grid sets the node's Method to mesh (its own settings rule
+  // here): put it back for the checks that follow.
+  int was = 0;
+  method->get(was);
   text->set("{\"format\": \"morphfx-scene\", \"version\": 1, \"features\": []}");
   rows->set(4);
   cols->set(4);
@@ -603,6 +609,7 @@ void checkOverlayGrid(Effect &fx, const Where &w) {
   expectOk(ov.penMotionAction(0, scale, mid, vp, 1), w, "overlay pen motion");
   expectOk(ov.penUpAction(0, scale, to, vp, 0), w, "overlay pen up");
   edit->set(0);
+  method->set(was);
   text->get(after);
   const std::size_t b = after.find("\"b\"");
   const bool moved = b != std::string::npos && after.find("[36, 25", b) != std::string::npos;

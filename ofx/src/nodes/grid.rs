@@ -1,13 +1,15 @@
 //! The Reset Grid push-button: an even grid of Grid Rows × Grid Columns
 //! nodes over Source A (the project when nothing is connected) written
-//! into Scene Text, the same on A and B, with method mesh; the user's
-//! features stay. One undo step; refused (Scene Text kept) when the text
+//! into Scene Text, the same on A and B, with method mesh (the node's
+//! Method too, where the node's own settings rule); the user's features
+//! stay. One undo step; refused (Scene Text kept) when the text
 //! cannot be edited.
 
 use morphfx::geom::RectD;
+use morphfx::make_warp::Method;
 
 use super::overlay::shapes;
-use super::params::{Reader, GRID_COLS, GRID_ROWS};
+use super::params::{Reader, GRID_COLS, GRID_ROWS, METHOD, SETTINGS_FROM_SCENE};
 use super::state::NodeState;
 use ofx_layer::clips::EffectHandle;
 use ofx_layer::{Failure, Outcome};
@@ -16,14 +18,28 @@ use ofx_layer::{Failure, Outcome};
 pub fn reset_grid(instance: &NodeState, effect: &EffectHandle, time: f64) -> Outcome {
     let r = Reader::new(instance.params(), instance.kind, time);
     let (rows, cols) = (r.int(&GRID_ROWS), r.int(&GRID_COLS));
+    // Where the node's own settings rule, its Method follows, so the grid
+    // just made is what renders and what the viewer shows.
+    let node_method = match r.bool(&SETTINGS_FROM_SCENE) {
+        true => None,
+        false => instance
+            .kind
+            .methods
+            .iter()
+            .position(|m| *m == Method::Mesh),
+    };
     let region = region(instance, effect, time);
     let result = region.and_then(|region| {
         let mut doc = shapes::document(instance, time)?;
         doc.make_grid(rows.max(2) as usize, cols.max(2) as usize, region)
             .map_err(shapes::refused)?;
-        instance
-            .params()
-            .edit_block("Reset Grid", || shapes::write(instance, &doc))
+        let params = instance.params();
+        params.edit_block("Reset Grid", || {
+            if let Some(mesh) = node_method {
+                params.set_int(&METHOD, mesh as i32)?;
+            }
+            shapes::write(instance, &doc)
+        })
     });
     shapes::settle(instance, effect, result)
 }
