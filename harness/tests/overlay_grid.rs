@@ -254,3 +254,60 @@ fn delete_resets_a_node_and_a_drag_keys_its_frame() {
     let labels = common::texts(&ov.draw(10.0, PX).unwrap());
     assert!(labels.iter().any(|t| t == "keys 0 [10]"), "{labels:?}");
 }
+
+/// Groups: a rubber band in empty space selects the nodes inside it (on
+/// the side the pen edits), a drag of one of them moves them all in one
+/// undo step, Ctrl-click adds a node of B, and Delete (over nothing)
+/// puts every selected node back where A has it.
+#[test]
+fn a_rubber_band_selects_nodes_that_move_and_reset_together() {
+    let inst = morph();
+    inst.set_project(300.0, 300.0);
+    inst.set_int("grid_rows", 4).unwrap();
+    inst.set_int("grid_cols", 4).unwrap();
+    inst.instance_changed("reset_grid", 0.0).unwrap();
+    inst.set_choice("overlay_edit", "B").unwrap();
+    let ov = common::overlay(&inst);
+    // The band round (1, 1) and (1, 2), at (100, 100) and (200, 100).
+    take_edit_log();
+    ov.drag(0.0, (50.0, 50.0), (250.0, 150.0), PX).unwrap();
+    assert!(
+        take_edit_log().iter().all(|l| !l.starts_with("begin")),
+        "a band edits nothing"
+    );
+    ov.drag(0.0, (100.0, 100.0), (100.0, 130.0), PX).unwrap();
+    let log = take_edit_log();
+    assert_eq!(
+        log.first().map(String::as_str),
+        Some("begin Move Grid Nodes")
+    );
+    assert_eq!(log.iter().filter(|l| l.starts_with("begin")).count(), 1);
+    let pair = scene(&inst).mesh_at(0.0).unwrap();
+    assert_eq!(pair.b.node(1, 1), v(100.0, 130.0));
+    assert_eq!(pair.b.node(1, 2), v(200.0, 130.0));
+    assert_eq!(pair.b.node(2, 1), v(100.0, 200.0));
+    assert_eq!(pair.a.node(1, 1), v(100.0, 100.0));
+    // The selection is drawn: squares round the two nodes.
+    assert!(ov.draw(0.0, PX).unwrap().iter().any(|c| matches!(
+        c,
+        DrawCall::Draw { points, .. } if points.contains(&[104.0, 126.0])
+    )));
+    // Ctrl-click adds (2, 1); then all three move together.
+    let control = 0xffe3;
+    ov.key(kOfxInteractActionKeyDown, 0.0, control).unwrap();
+    ov.click(0.0, (100.0, 200.0), PX).unwrap();
+    ov.key(kOfxInteractActionKeyUp, 0.0, control).unwrap();
+    ov.drag(0.0, (200.0, 130.0), (210.0, 130.0), PX).unwrap();
+    let pair = scene(&inst).mesh_at(0.0).unwrap();
+    assert_eq!(
+        [pair.b.node(1, 1), pair.b.node(1, 2), pair.b.node(2, 1)],
+        [v(110.0, 130.0), v(210.0, 130.0), v(110.0, 200.0)]
+    );
+    // Delete over empty space resets the three.
+    ov.pen(kOfxInteractActionPenMotion, 0.0, (150.0, 250.0), PX)
+        .unwrap();
+    ov.key(kOfxInteractActionKeyDown, 0.0, 0xffff).unwrap();
+    let pair = scene(&inst).mesh_at(0.0).unwrap();
+    assert_eq!(pair.a, pair.b);
+    assert!(take_violations().is_empty());
+}

@@ -7,6 +7,7 @@
 //! calls; `pen` holds what the pen does, `shapes` the Scene Text edits.
 
 mod grid;
+mod grid_pen;
 mod hit;
 mod outline;
 pub mod paint;

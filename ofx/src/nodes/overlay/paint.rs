@@ -3,7 +3,7 @@
 
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::Vec2;
-use morphfx::warp::mesh::Mesh;
+use morphfx::warp::mesh::{Mesh, Node};
 
 use super::grid::{self, Grid};
 use super::outline::{per_span, Outline};
@@ -31,6 +31,10 @@ pub struct Frame<'a> {
     pub building: (&'a [Vec2], Option<Vec2>),
     /// The scene's mesh, when the method is mesh.
     pub grid: Option<&'a Grid>,
+    /// The grid nodes selected, on one side.
+    pub grid_selection: Option<&'a (Side, Vec<Node>)>,
+    /// A rubber band being drawn, corner to corner.
+    pub band: Option<[Vec2; 2]>,
 }
 
 /// A's features.
@@ -38,6 +42,8 @@ pub const A_COLOUR: [f32; 3] = [1.0, 0.55, 0.1];
 /// B's features.
 pub const B_COLOUR: [f32; 3] = [0.25, 0.8, 1.0];
 const BETWEEN_COLOUR: [f32; 3] = [0.95, 0.95, 0.95];
+/// Selected grid nodes and the rubber band that selects them.
+const SELECTED_COLOUR: [f32; 3] = [1.0, 1.0, 0.3];
 
 /// A suggested pair's colour by its confidence, on both sides until the
 /// artist edits it: red when doubtful, through yellow, to green when sure.
@@ -191,6 +197,25 @@ impl Pen<'_> {
                 self.painter.width(2.0);
                 self.handle(mesh.nodes(), h.part);
             }
+            if let Some((_, nodes)) = frame.grid_selection.filter(|(s, _)| *s == side) {
+                self.painter.width(2.0);
+                self.colour(SELECTED_COLOUR, 1.0);
+                let marks: Vec<Vec2> = nodes
+                    .iter()
+                    .filter(|n| n.row < mesh.rows() && n.col < mesh.cols())
+                    .flat_map(|n| self.square(mesh.node(n.row, n.col), HANDLE_PX))
+                    .collect();
+                self.painter.lines(&marks);
+            }
+        }
+        if let Some([p, q]) = frame.band {
+            self.painter.stipple(Stipple::Dash);
+            self.painter.width(1.0);
+            self.colour(SELECTED_COLOUR, 0.9);
+            let corners = [p, Vec2::new(q.x, p.y), q, Vec2::new(p.x, q.y), p];
+            let pts: Vec<Vec2> = corners.iter().map(|c| self.at(*c)).collect();
+            self.painter.strip(&pts);
+            self.painter.stipple(Stipple::Solid);
         }
     }
 

@@ -9,7 +9,7 @@ use morphfx::geom::Vec2;
 
 use super::hit;
 
-use super::grid::node_at;
+use super::grid_pen;
 use super::shapes::{self, refused};
 use super::state::{editable, pixel_of, Building, Drag, Handle, Owner, Part};
 use super::view::grabbable;
@@ -34,7 +34,7 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
     }
     let r = Reader::new(instance.params(), instance.kind, pen.time);
     let tool: DrawTool = r.choice(&DRAW_TOOL);
-    let (handle, sides) = {
+    let (handle, sides, on_grid) = {
         let state = instance.overlay.locked();
         let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
         let (outlines, grid) = grabbable(instance, &r, pen.time);
@@ -45,7 +45,7 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
             pixel_of(&state, &pen),
             &sides,
         );
-        (handle.map(|h| (h, outlines)), sides)
+        (handle.map(|h| (h, outlines)), sides, grid.is_some())
     };
     if sides.is_empty() {
         return Ok(Reply::Default);
@@ -64,12 +64,16 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
                 Ok(drag) => drag,
                 Err(why) => return refuse(instance, effect, why),
             },
-            Owner::Grid => match grab_grid(instance, h, pen) {
-                Ok(drag) => drag,
+            Owner::Grid => match grid_pen::grab(instance, h, pen) {
+                Ok(Some(drag)) => drag,
+                // A Shift- or Ctrl-click chose the node: nothing to drag.
+                Ok(None) => return Ok(Reply::Done),
                 Err(why) => return refuse(instance, effect, why),
             },
             Owner::File(_) => return Ok(Reply::Default),
         },
+        // Over the grid, empty space is where a rubber band starts.
+        None if on_grid => grid_pen::start_band(instance, pen),
         None => match tool {
             DrawTool::Line => match start_new_line(instance, pen)? {
                 Some(drag) => drag,
@@ -185,26 +189,6 @@ fn grab_shape(
     })
 }
 
-/// Grabs a node of Scene Text's mesh, opening the drag's edit block.
-fn grab_grid(instance: &NodeState, h: Handle, pen: Pen) -> Outcome<Drag> {
-    let doc = shapes::document(instance, pen.time)?;
-    let Part::Point(i) = h.part else {
-        return Err(Failure::BadInput("a grid is grabbed by its nodes".into()));
-    };
-    let cols = doc
-        .scene()
-        .mesh_at(pen.time)
-        .map(|m| m.a.cols())
-        .ok_or_else(|| Failure::BadInput("Scene Text has no mesh".into()))?;
-    instance.params().begin_edit("Move Grid Node")?;
-    Ok(Drag::Grid {
-        side: h.side,
-        nodes: vec![node_at(i, cols)],
-        from: pen.at,
-        before: Box::new(doc),
-    })
-}
-
 /// The point tool: a point feature at the pen, dragged until pen up.
 fn new_point(instance: &NodeState, pen: Pen) -> Outcome<Drag> {
     let mut doc = shapes::document(instance, pen.time)?;
@@ -251,6 +235,7 @@ fn write_drag(instance: &NodeState, drag: &Drag, pen: Pen) -> Outcome {
             }
             Ok(())
         }
+        Drag::Band { .. } => Ok(()),
         Drag::Grid {
             side,
             nodes,
@@ -291,7 +276,16 @@ pub fn motion(
     pen: Pen,
     redraw: &mut dyn FnMut(),
 ) -> Outcome<Reply> {
-    let drag = instance.overlay.locked().drag.clone();
+    let drag = {
+        let mut state = instance.overlay.locked();
+        if let Some(Drag::Band { to, .. }) = state.drag.as_mut() {
+            *to = pen.at;
+            drop(state);
+            redraw();
+            return Ok(Reply::Done);
+        }
+        state.drag.clone()
+    };
     if let Some(drag) = drag {
         // A drag that would break the scene keeps its last good position.
         return match write_drag(instance, &drag, pen) {
@@ -337,6 +331,16 @@ pub fn up(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Repl
     let Some(drag) = drag else {
         return Ok(Reply::Default);
     };
+    if let Drag::Band { from, .. } = drag {
+        let r = Reader::new(params, instance.kind, pen.time);
+        let sides = {
+            let state = instance.overlay.locked();
+            editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state)
+        };
+        let (_, grid) = grabbable(instance, &r, pen.time);
+        grid_pen::end_band(instance, grid.as_ref(), [from, pen.at], &sides);
+        return Ok(Reply::Done);
+    }
     let written = match &drag {
         Drag::NewLine {
             start,
@@ -508,6 +512,10 @@ pub fn key_down(
         state.hover.take()
     };
     let Some(handle) = hovered else {
+        let selected = instance.overlay.locked().grid_selection.is_some();
+        if selected && grid_pen::reset(instance, effect, time, None)? {
+            return Ok(Reply::Done);
+        }
         return Ok(Reply::Default);
     };
     match (handle.owner, handle.part) {
@@ -524,18 +532,12 @@ pub fn key_down(
             instance.overlay.locked().selected = None;
             shapes::settle(instance, effect, result)?;
         }
-        (Owner::Grid, Part::Point(i)) => {
-            let result = shapes::document(instance, time).and_then(|mut doc| {
-                let cols = doc.scene().mesh_at(time).map_or(1, |m| m.a.cols());
-                doc.reset_nodes(time, handle.side, &[node_at(i, cols)])
-                    .map_err(refused)?;
-                instance
-                    .params()
-                    .edit_block("Reset Grid Node", || shapes::write(instance, &doc))
-            });
-            shapes::settle(instance, effect, result)?;
+        (Owner::Grid, _) => {
+            if !grid_pen::reset(instance, effect, time, Some(handle))? {
+                return Ok(Reply::Default);
+            }
         }
-        (Owner::File(_) | Owner::Grid, _) => return Ok(Reply::Default),
+        (Owner::File(_), _) => return Ok(Reply::Default),
     }
     Ok(Reply::Done)
 }

@@ -52,6 +52,9 @@ pub struct State {
     pub(super) building: Option<Building>,
     /// The Scene Text shape last drawn or grabbed (Delete Shape's target).
     pub(super) selected: Option<usize>,
+    /// The grid nodes selected, all on one side: a drag of one of them
+    /// moves them all, Delete resets them.
+    pub(super) grid_selection: Option<(Side, Vec<Node>)>,
     /// An edit was refused and its message is on the node.
     pub(super) refused: bool,
     pub(super) shift: bool,
@@ -78,6 +81,8 @@ pub(super) enum Drag {
         start: Vec2,
         count_before: i32,
     },
+    /// A rubber band from `from` to `to` selecting grid nodes (no edit).
+    Band { from: Vec2, to: Vec2 },
     /// Moving Scene Text's mesh nodes `nodes` on `side` by the pen's
     /// motion since `from`; each event edits `before` afresh, no further
     /// than the grid stays unfolded.

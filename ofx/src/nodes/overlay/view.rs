@@ -10,7 +10,7 @@ use morphfx::warp::field::FieldSettings;
 use super::grid::Grid;
 use super::outline::{self, Outline};
 use super::paint::{self, Frame};
-use super::state::Owner;
+use super::state::{Drag, Owner};
 use crate::nodes::inputs::{load_scene, progress_at, scene_settings};
 use crate::nodes::lines::slot_lines;
 use crate::nodes::params::{
@@ -160,13 +160,18 @@ pub fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) ->
         .iter()
         .map(|o| outline::in_between(o, v.t, field))
         .collect();
-    let (hover, building) = {
+    let (hover, building, selection, band) = {
         let state = instance.overlay.locked();
         let building = state
             .building
             .as_ref()
             .map(|b| (b.points.clone(), b.cursor));
-        (state.hover, building.unwrap_or_default())
+        let band = match &state.drag {
+            Some(Drag::Band { from, to }) => Some([*from, *to]),
+            _ => None,
+        };
+        let selection = state.grid_selection.clone();
+        (state.hover, building.unwrap_or_default(), selection, band)
     };
     paint::paint(
         painter,
@@ -179,6 +184,8 @@ pub fn draw(instance: &NodeState, args: &DrawArgs, painter: &mut dyn Painter) ->
             keys: (&v.keys, time),
             building: (&building.0, building.1),
             grid: v.grid.as_ref(),
+            grid_selection: selection.as_ref(),
+            band,
         },
     );
     Ok(Reply::Done)
