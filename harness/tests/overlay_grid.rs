@@ -309,5 +309,15 @@ fn a_rubber_band_selects_nodes_that_move_and_reset_together() {
     ov.key(kOfxInteractActionKeyDown, 0.0, 0xffff).unwrap();
     let pair = scene(&inst).mesh_at(0.0).unwrap();
     assert_eq!(pair.a, pair.b);
+    // A click in empty space clears a selection: no square round (1, 1).
+    let square_at_node = |calls: &[DrawCall]| {
+        calls
+            .iter()
+            .any(|c| matches!(c, DrawCall::Draw { points, .. } if points.contains(&[104.0, 96.0])))
+    };
+    ov.drag(0.0, (50.0, 50.0), (150.0, 150.0), PX).unwrap();
+    assert!(square_at_node(&ov.draw(0.0, PX).unwrap()));
+    ov.click(0.0, (150.0, 250.0), PX).unwrap();
+    assert!(!square_at_node(&ov.draw(0.0, PX).unwrap()));
     assert!(take_violations().is_empty());
 }
