@@ -578,3 +578,51 @@ fn suggest_features_adds_sure_pairs_to_scene_text_and_cancel_adds_none() {
     let (progress, open) = inst.progress_log();
     assert!(!open && progress.last() == Some(&1.0), "{progress:?}");
 }
+
+/// Track Forward carries Scene Text's mesh: every interior node keyed at
+/// every frame where the picture under it went (the textured plate's
+/// nodes are all followed by their own patches), the frozen border where
+/// it was, in the same one write as the shapes.
+#[test]
+fn track_forward_carries_the_grids_nodes_with_the_picture() {
+    let motion = button_motion();
+    let inst = common::bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let source = shot("OfxBitDepthFloat", &motion);
+    inst.connect("SourceA", source.clone()).unwrap();
+    inst.connect("SourceB", source).unwrap();
+    let (rows, cols) = (5usize, 5usize);
+    let node = |r: usize, c: usize| Vec2::new(48.0 * c as f64, 40.0 * r as f64);
+    let a: Vec<Vec2> = (0..rows * cols).map(|i| node(i / cols, i % cols)).collect();
+    // B's middle node a little off A's.
+    let mut b = a.clone();
+    b[2 * cols + 2] += Vec2::new(6.0, -4.0);
+    let list =
+        |nodes: &[Vec2]| serde_json::json!(nodes.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>());
+    let text = serde_json::json!({"format": "morphfx-scene", "version": 1, "method": "mesh",
+        "mesh": {"rows": rows, "cols": cols, "a": list(&a), "b": list(&b)}})
+    .to_string();
+    inst.set_string("scene_text", &text).unwrap();
+    morphfx_harness::host::params::take_edit_log();
+    inst.instance_changed("track_forward", 0.0).unwrap();
+    let log = morphfx_harness::host::params::take_edit_log();
+    assert_eq!(log, ["begin Track Forward", "set scene_text", "end"]);
+    let scene = morphfx::scene::Scene::read(&inst.string("scene_text").unwrap()).unwrap();
+    let frames: Vec<f64> = scene.meshes.iter().map(|m| m.0).collect();
+    assert_eq!(frames, (0..=10).map(f64::from).collect::<Vec<_>>());
+    let mut worst = 0.0f64;
+    for (f, (_, pair)) in scene.meshes.iter().enumerate() {
+        for (mesh, start) in [(&pair.a, &a), (&pair.b, &b)] {
+            for (i, p) in mesh.nodes().iter().enumerate() {
+                let (r, c) = (i / cols, i % cols);
+                if r == 0 || c == 0 || r + 1 == rows || c + 1 == cols {
+                    assert_eq!(*p, start[i], "border node {i} at frame {f}");
+                } else {
+                    worst = worst.max(p.distance(motion.at(f, start[i])));
+                }
+            }
+        }
+    }
+    assert!(worst < 0.3, "worst {worst} px off the true motion");
+}

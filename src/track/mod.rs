@@ -11,11 +11,13 @@
 //! docs/tracking.md compares it with the alternatives, with measurements.
 //!
 //! Layers: [`grey`] (frames) → [`template`] → [`point`] → [`feature`] (a
-//! side of a feature; lines fitted along their length) → [`shot`] (a range
-//! of frames from its keys).
+//! side of a feature; lines fitted along their length) and [`grid`] (a
+//! mesh's grid; nodes on flat ground move with their neighbours) →
+//! [`shot`] (a range of frames from its keys).
 
 pub mod feature;
 pub mod grey;
+pub mod grid;
 mod linear;
 pub mod point;
 pub mod shot;
@@ -23,6 +25,7 @@ pub mod template;
 
 pub use feature::{SideEstimate, SideTracker};
 pub use grey::{Grey, Pyramid};
+pub use grid::{GridEstimate, GridTracker};
 pub use point::{Estimate, PointTracker};
 pub use shot::{track_side, Frames, SideKey};
 pub use template::{Affine, TrackSettings};

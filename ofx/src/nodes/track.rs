@@ -1,9 +1,11 @@
 //! The Track Forward and Track Backward push-buttons: every enabled line
-//! slot and every shape of Scene Text followed through its source from the
-//! current frame, one frame at a time, to the next key in that direction
-//! (or the end of the clip), keyed at each frame: A's points on Source A,
-//! B's on Source B (Morph). Slots are keyed in their params; shapes in
-//! Scene Text, written once at the end (one undo step with the slots').
+//! slot, every shape of Scene Text and Scene Text's mesh followed through
+//! its source from the current frame, one frame at a time, to the next key
+//! in that direction (or the end of the clip), keyed at each frame: A's
+//! points on Source A, B's on Source B (Morph). Slots are keyed in their
+//! params; shapes and the mesh in Scene Text, written once at the end (one
+//! undo step with the slots'). A mesh's nodes on flat ground move with
+//! their neighbours; a grid that would fold is keyed no further.
 //!
 //! The core's tracker does the work (docs/tracking.md): each frame is
 //! matched against the current frame's picture, so nothing drifts. A line
@@ -14,7 +16,8 @@ use std::sync::Arc;
 
 use morphfx::features::{FeatureKind, Side};
 use morphfx::geom::{PixelScale, Vec2};
-use morphfx::track::{Grey, Pyramid, SideTracker, TrackSettings};
+use morphfx::track::{Grey, GridTracker, Pyramid, SideTracker, TrackSettings};
+use morphfx::warp::mesh::Mesh;
 
 use morphfx::scene::edit::Document;
 
@@ -38,6 +41,17 @@ enum Target {
     Slot(usize),
     /// Scene Text's feature `i`.
     Shape(usize),
+}
+
+/// One side of Scene Text's mesh being tracked.
+struct GridFollower {
+    side: Side,
+    rows: usize,
+    cols: usize,
+    tracker: GridTracker,
+    /// The frame it was lost or would have folded at, after which it is
+    /// keyed no more, and why.
+    stopped: Option<(f64, &'static str)>,
 }
 
 /// One side of one slot or shape being tracked.
@@ -86,14 +100,21 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
         .as_ref()
         .map(|d| d.scene().features_at(time))
         .unwrap_or_default();
-    if lines.is_empty() && shape_list.is_empty() {
+    let mesh = doc.as_ref().and_then(|d| d.scene().mesh_at(time));
+    if lines.is_empty() && shape_list.is_empty() && mesh.is_none() {
         return Ok(());
     }
     let sources = sources((kind, instance.context), effect, params, time)?;
-    let shape_keys = doc.as_ref().map(Document::keyed_frames).unwrap_or_default();
+    let mut shape_keys = doc.as_ref().map(Document::keyed_frames).unwrap_or_default();
+    shape_keys.extend(
+        doc.as_ref()
+            .map(Document::mesh_keyed_frames)
+            .unwrap_or_default(),
+    );
     let stop = stop_frame(params, effect, &sources, (&lines, &shape_keys), time, step);
     let settings = TrackSettings::default();
     let mut followers = Vec::new();
+    let mut grids = Vec::new();
     for (side, source) in &sources {
         let (key, scale) = source.pyramid(time, settings.levels)?.ok_or_else(|| {
             Failure::BadInput(format!(
@@ -118,6 +139,17 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
                 lost_at: None,
             });
         }
+        if let Some(pair) = &mesh {
+            let m = pair.side(*side);
+            let px: Vec<Vec2> = m.nodes().iter().map(|p| scale.to_pixel(*p)).collect();
+            grids.push(GridFollower {
+                side: *side,
+                rows: m.rows(),
+                cols: m.cols(),
+                tracker: GridTracker::new(m.rows(), m.cols(), &px, &key, &settings),
+                stopped: None,
+            });
+        }
     }
     let label = if step > 0 {
         "Track Forward"
@@ -126,12 +158,12 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
     };
     effect.progress_start(label);
     let result = params.edit_block(label, || {
-        let mut keys = Vec::new();
+        let mut keys = Keys::default();
         let swept = sweep(
             effect,
             params,
             &sources,
-            &mut followers,
+            (&mut followers, &mut grids),
             (time, stop, step),
             &settings,
             &mut keys,
@@ -147,20 +179,39 @@ pub fn track_lines(instance: &NodeState, effect: &EffectHandle, time: f64, step:
     effect.progress_end();
     instance.purge();
     result?;
-    report_lost(effect, &followers, &shape_list);
+    report_lost(effect, &followers, &shape_list, &grids);
     Ok(())
 }
 
-/// Keys Scene Text's shapes: at the start frame as they are (so a static
-/// scene keeps its shape there), then where the tracker found them.
-fn key_shapes(instance: &NodeState, doc: &mut Document, time: f64, keys: &[ShapeKey]) -> Outcome {
+/// Keys Scene Text's shapes and mesh: at the start frame as they are (so
+/// a static scene keeps its shape there), then where the tracker found
+/// them.
+fn key_shapes(instance: &NodeState, doc: &mut Document, time: f64, keys: &Keys) -> Outcome {
     doc.key_here(time).map_err(shapes::refused)?;
-    doc.set_points(keys).map_err(shapes::refused)?;
+    doc.set_points(&keys.shapes).map_err(shapes::refused)?;
+    for (frame, side, nodes) in &keys.meshes {
+        doc.set_mesh_side(*frame, *side, nodes)
+            .map_err(shapes::refused)?;
+    }
     shapes::write(instance, doc)
 }
 
 /// A shape's points found at a frame: `(frame, feature, side, points)`.
 type ShapeKey = (f64, usize, Side, Vec<Vec2>);
+
+/// What a sweep found for Scene Text: shapes' points, and a mesh side's
+/// nodes `(frame, side, nodes)`, canonical.
+#[derive(Default)]
+struct Keys {
+    shapes: Vec<ShapeKey>,
+    meshes: Vec<(f64, Side, Vec<Vec2>)>,
+}
+
+impl Keys {
+    fn is_empty(&self) -> bool {
+        self.shapes.is_empty() && self.meshes.is_empty()
+    }
+}
 
 /// The node's sources with their sides and frame offsets, each connected.
 fn sources<'e>(
@@ -239,10 +290,10 @@ fn sweep(
     effect: &EffectHandle,
     params: &Params,
     sources: &[(Side, Source<'_>)],
-    followers: &mut [Follower],
+    (followers, grids): (&mut [Follower], &mut [GridFollower]),
     (time, stop, step): (f64, f64, i64),
     settings: &TrackSettings,
-    shape_keys: &mut Vec<ShapeKey>,
+    keys: &mut Keys,
 ) -> Outcome {
     let total = ((stop - time) * step as f64).round().max(0.0) as i64;
     for n in 1..=total {
@@ -272,25 +323,61 @@ fn sweep(
                             params.set_point_at(&id, frame, (at.x, at.y))?;
                         }
                     }
-                    Target::Shape(i) => shape_keys.push((frame, i, f.side, found.collect())),
+                    Target::Shape(i) => keys.shapes.push((frame, i, f.side, found.collect())),
                 }
             }
+            for g in grids
+                .iter_mut()
+                .filter(|g| g.side == *side && g.stopped.is_none())
+            {
+                follow_grid(g, &pyramid, scale, frame, settings, keys);
+            }
         }
-        if followers.iter().all(|f| f.lost_at.is_some())
-            || !effect.progress_update(n as f64 / total as f64)
-        {
+        let all_stopped = followers.iter().all(|f| f.lost_at.is_some())
+            && grids.iter().all(|g| g.stopped.is_some());
+        if all_stopped || !effect.progress_update(n as f64 / total as f64) {
             break;
         }
     }
     Ok(())
 }
 
-/// Names each line or shape that lost track, and where.
+/// One side of the mesh at `frame`: keyed where the tracker puts it,
+/// unless it is lost or would fold (then it stops there).
+fn follow_grid(
+    g: &mut GridFollower,
+    pyramid: &Pyramid,
+    scale: PixelScale,
+    frame: f64,
+    settings: &TrackSettings,
+    keys: &mut Keys,
+) {
+    let e = g.tracker.step(pyramid, settings);
+    if e.is_lost() {
+        g.stopped = Some((frame, "lost"));
+        return;
+    }
+    let nodes: Vec<Vec2> = e.nodes.iter().map(|p| scale.to_canonical(*p)).collect();
+    let unfolded = Mesh::new(g.rows, g.cols, nodes.clone()).is_ok_and(|m| m.check("mesh").is_ok());
+    if !unfolded {
+        g.stopped = Some((frame, "would fold"));
+        return;
+    }
+    keys.meshes.push((frame, g.side, nodes));
+}
+
+/// Names each line, shape or grid that lost track, and where.
 fn report_lost(
     effect: &EffectHandle,
     followers: &[Follower],
     shapes: &[morphfx::features::Feature],
+    grids: &[GridFollower],
 ) {
+    let grid_lost = grids.iter().filter_map(|g| {
+        let side = if g.side == Side::A { "A" } else { "B" };
+        g.stopped
+            .map(|(t, why)| format!("the grid on {side} at frame {t} ({why})"))
+    });
     let lost: Vec<String> = followers
         .iter()
         .filter_map(|f| {
@@ -304,6 +391,7 @@ fn report_lost(
             };
             f.lost_at.map(|t| format!("{what} on {side} at frame {t}"))
         })
+        .chain(grid_lost)
         .collect();
     if !lost.is_empty() {
         effect.warning(

@@ -88,6 +88,44 @@ impl Document {
     }
 }
 
+impl Document {
+    /// Sets the mesh on `side` at `frame` to `nodes` (row-major from the
+    /// bottom row, as many as the mesh has): in a keyed mesh its key there,
+    /// made when there is none; else the static mesh. What a tracker found.
+    pub fn set_mesh_side(&mut self, frame: f64, side: Side, nodes: &[Vec2]) -> Result<()> {
+        let mut pair = self
+            .scene
+            .mesh_at(frame)
+            .ok_or_else(|| Error::scene("mesh", "the scene has no mesh to edit"))?;
+        let (rows, cols) = (pair.a.rows(), pair.a.cols());
+        let mesh = Mesh::new(rows, cols, nodes.to_vec())?;
+        match side {
+            Side::A => pair.a = mesh,
+            Side::B => pair.b = mesh,
+        }
+        let all: Vec<Node> = (0..rows * cols)
+            .map(|i| Node {
+                row: i / cols,
+                col: i % cols,
+            })
+            .collect();
+        self.edit(|doc| doc.set_mesh(frame, &pair, &all))
+    }
+
+    /// The frames the mesh is keyed at, in order (none for a static mesh).
+    pub fn mesh_keyed_frames(&self) -> Vec<f64> {
+        let keys = self
+            .root
+            .get("mesh")
+            .and_then(|m| m.get("keyframes"))
+            .and_then(Value::as_array);
+        keys.into_iter()
+            .flatten()
+            .filter_map(|k| k.get("frame").and_then(Value::as_f64))
+            .collect()
+    }
+}
+
 /// `pair` with `nodes` on `side` moved by `delta` (border nodes on both
 /// sides); sizes only are checked.
 fn moved(pair: &MeshPair, side: Side, nodes: &[Node], delta: Vec2) -> Result<MeshPair> {
