@@ -321,3 +321,52 @@ fn a_rubber_band_selects_nodes_that_move_and_reset_together() {
     assert!(!square_at_node(&ov.draw(0.0, PX).unwrap()));
     assert!(take_violations().is_empty());
 }
+
+/// Rows and columns: Shift+Ctrl-click near a column line adds a row
+/// through the pen (near a row line, a column); Add Column adds one
+/// through the last point clicked on the grid, Remove Row takes out the
+/// row nearest it; each one undo step. A border row stays.
+#[test]
+fn rows_and_columns_are_added_at_the_pen_and_removed_by_the_buttons() {
+    let inst = morph();
+    inst.set_string("scene_text", GRID).unwrap();
+    inst.set_choice("overlay_edit", "B").unwrap();
+    let ov = common::overlay(&inst);
+    let (shift, control) = (0xffe1, 0xffe3);
+    take_edit_log();
+    // (98, 150) is 2 px from column 1 and halfway between rows 1 and 2.
+    ov.key(kOfxInteractActionKeyDown, 0.0, shift).unwrap();
+    ov.key(kOfxInteractActionKeyDown, 0.0, control).unwrap();
+    assert_eq!(ov.click(0.0, (98.0, 150.0), PX).unwrap(), Answer::Trapped);
+    ov.key(kOfxInteractActionKeyUp, 0.0, shift).unwrap();
+    ov.key(kOfxInteractActionKeyUp, 0.0, control).unwrap();
+    let log = take_edit_log();
+    assert_eq!(log, ["begin Add Row", "set scene_text", "end"]);
+    let pair = scene(&inst).mesh_at(0.0).unwrap();
+    assert_eq!((pair.a.rows(), pair.a.cols()), (4, 3));
+    let (_, r) = pair
+        .locate(morphfx::features::Side::B, v(98.0, 150.0))
+        .unwrap();
+    assert!(
+        (r - 2.0).abs() < 1e-3,
+        "the new row 2 passes through the pen: {r}"
+    );
+    // Its border node is on the border, between rows 1 and 2 as they were.
+    let end = pair.b.node(2, 0);
+    assert!(end.x == 0.0 && end.y > 140.0 && end.y < 160.0, "{end:?}");
+
+    // Add Column through the same point, then Remove Row there.
+    inst.instance_changed("grid_add_column", 0.0).unwrap();
+    let pair = scene(&inst).mesh_at(0.0).unwrap();
+    assert_eq!((pair.a.rows(), pair.a.cols()), (4, 4));
+    inst.instance_changed("grid_remove_row", 0.0).unwrap();
+    let pair = scene(&inst).mesh_at(0.0).unwrap();
+    assert_eq!((pair.a.rows(), pair.a.cols()), (3, 4));
+    assert_eq!(pair.b.node(1, 2), v(110.0, 95.0), "B's moved node stays");
+    // A border row stays: the refusal is shown, Scene Text kept.
+    let before = inst.string("scene_text").unwrap();
+    ov.click(0.0, (150.0, 2.0), PX).unwrap();
+    inst.instance_changed("grid_remove_row", 0.0).unwrap();
+    assert_eq!(inst.string("scene_text").unwrap(), before);
+    assert!(inst.persistent_message().is_some());
+}

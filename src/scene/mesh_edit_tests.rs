@@ -137,3 +137,36 @@ fn keys_are_made_where_the_mesh_is_edited() {
     let frames: Vec<f64> = d.scene().meshes.iter().map(|(f, _)| *f).collect();
     assert_eq!(frames, [5.0, 10.0, 20.0]);
 }
+
+/// A column added through a point of B lands in every key, through that
+/// point on B, where each key's surfaces pass; taken out again, every key
+/// is as it was. A border column stays.
+#[test]
+fn a_column_added_lands_in_every_key_and_comes_out_again() {
+    use crate::warp::mesh::Line;
+    let mut d = doc();
+    d.key_here(0.0).unwrap();
+    d.drag_nodes(10.0, Side::B, &[MIDDLE], Vec2::new(0.0, 10.0))
+        .unwrap();
+    let before = d.scene().meshes.clone();
+    let through = Vec2::new(60.0, 120.0);
+    d.add_grid_line(10.0, Side::B, through, Line::Column)
+        .unwrap();
+    let keys = &d.scene().meshes;
+    assert_eq!(keys.len(), 2);
+    for (_, pair) in keys {
+        assert_eq!((pair.a.rows(), pair.a.cols()), (3, 4));
+    }
+    // On B at frame 10 the new column passes through the point.
+    let b10 = &keys[1].1.b;
+    let column: Vec<Vec2> = (0..3).map(|r| b10.node(r, 1)).collect();
+    let (s, _) = keys[1].1.locate(Side::B, through).unwrap();
+    assert!(
+        (s - 1.0).abs() < 1e-4,
+        "the point is on the new column: {s}"
+    );
+    assert_eq!(column[0], Vec2::new(column[0].x, 0.0));
+    d.remove_grid_line(Line::Column, 1).unwrap();
+    assert_eq!(d.scene().meshes, before);
+    assert!(d.remove_grid_line(Line::Column, 0).is_err());
+}

@@ -7,6 +7,7 @@ use std::ffi::CStr;
 use std::marker::PhantomData;
 
 use morphfx::geom::RectD;
+use morphfx::warp::mesh::Line;
 
 use super::kind::{NodeKind, MASK_CLIP, OUTPUT_CLIP, TIMING_CLIP, VERSION};
 use super::state::NodeState;
@@ -182,6 +183,14 @@ fn param_changed(node: &NodeState, effect: &EffectHandle, change: &ParamChange) 
         suggest::suggest_features(node, effect, time)
     } else if change.is(&params::RESET_GRID) {
         grid::reset_grid(node, effect, time)
+    } else if change.is(&params::ADD_ROW) {
+        overlay::add_line(node, effect, time, Line::Row)
+    } else if change.is(&params::ADD_COLUMN) {
+        overlay::add_line(node, effect, time, Line::Column)
+    } else if change.is(&params::REMOVE_ROW) {
+        overlay::remove_line(node, effect, time, Line::Row)
+    } else if change.is(&params::REMOVE_COLUMN) {
+        overlay::remove_line(node, effect, time, Line::Column)
     } else if change.is(&params::LINE_COUNT) {
         lines::hide_unused(node.kind, node.params(), time);
         Ok(())

@@ -6,10 +6,10 @@
 
 use serde_json::{Map, Value};
 
-use super::{mesh_key_at, point_json, points_json, Document, Editor};
+use super::{mesh_key_at, number, point_json, points_json, Document, Editor};
 use crate::features::Side;
 use crate::geom::{RectD, Vec2};
-use crate::warp::mesh::{Mesh, MeshPair, Node};
+use crate::warp::mesh::{Line, Mesh, MeshPair, Node};
 use crate::{Error, Result};
 
 /// How finely a drag's path is walked for the first fold before the
@@ -110,6 +110,88 @@ impl Document {
             })
             .collect();
         self.edit(|doc| doc.set_mesh(frame, &pair, &all))
+    }
+
+    /// A row (or column) added to the mesh through `through` on `side` at
+    /// `frame`, in every key at the same place of the surfaces, so each
+    /// key's mesh gains it where its own surfaces pass
+    /// ([`MeshPair::with_line`]).
+    pub fn add_grid_line(
+        &mut self,
+        frame: f64,
+        side: Side,
+        through: Vec2,
+        line: Line,
+    ) -> Result<()> {
+        let pair = self
+            .scene
+            .mesh_at(frame)
+            .ok_or_else(|| Error::scene("mesh", "the scene has no mesh to edit"))?;
+        let (s, r) = pair.locate(side, through).ok_or_else(|| {
+            Error::scene(
+                "mesh",
+                format!(
+                    "({:.1}, {:.1}) is not on the mesh: a {} is added through a point inside it",
+                    through.x,
+                    through.y,
+                    line.name()
+                ),
+            )
+        })?;
+        let at = match line {
+            Line::Row => r,
+            Line::Column => s,
+        };
+        self.reshape_mesh(|p| p.with_line(line, at))
+    }
+
+    /// Row (or column) `index` taken out of the mesh in every key.
+    pub fn remove_grid_line(&mut self, line: Line, index: usize) -> Result<()> {
+        self.reshape_mesh(|p| p.without_line(line, index))
+    }
+
+    /// Every key of the mesh (or the static one) replaced by `change` of it:
+    /// its size and nodes rewritten, bottom row first; its other keys kept.
+    fn reshape_mesh(&mut self, change: impl Fn(&MeshPair) -> Result<MeshPair>) -> Result<()> {
+        let keyed = !self.mesh_keyed_frames().is_empty();
+        let changed = self
+            .scene
+            .meshes
+            .iter()
+            .map(|(frame, pair)| Ok((*frame, change(pair)?)))
+            .collect::<Result<Vec<_>>>()?;
+        let Some((_, first)) = changed.first() else {
+            return Err(Error::scene("mesh", "the scene has no mesh to edit"));
+        };
+        let (rows, cols) = (first.a.rows(), first.a.cols());
+        self.edit(|doc| {
+            let mesh = doc
+                .root
+                .get_mut("mesh")
+                .and_then(Value::as_object_mut)
+                .ok_or_else(|| Error::scene("mesh", "the scene has no mesh to edit"))?;
+            mesh.insert("rows".into(), Value::from(rows));
+            mesh.insert("cols".into(), Value::from(cols));
+            let sides = |pair: &MeshPair, into: &mut Map<String, Value>| {
+                into.insert("a".into(), points_json(pair.a.nodes()));
+                into.insert("b".into(), points_json(pair.b.nodes()));
+            };
+            if keyed {
+                let keys = changed
+                    .iter()
+                    .map(|(frame, pair)| {
+                        let mut key = Map::new();
+                        key.insert("frame".into(), number(*frame));
+                        sides(pair, &mut key);
+                        Value::Object(key)
+                    })
+                    .collect();
+                mesh.insert("keyframes".into(), Value::Array(keys));
+            } else {
+                sides(&changed[0].1, mesh);
+            }
+            Ok(())
+        })
     }
 
     /// The frames the mesh is keyed at, in order (none for a static mesh).

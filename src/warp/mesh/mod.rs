@@ -12,10 +12,12 @@
 
 pub mod fant;
 mod patch;
+mod refine;
 pub mod spline;
 mod two_pass;
 
 pub use patch::MeshWarp;
+pub use refine::Line;
 pub use two_pass::{two_pass, two_pass_into};
 
 use crate::choice::Choice;

@@ -39,7 +39,7 @@ type Params = (f64, f64);
 
 /// One mesh as bicubic patches in power form, one per cell.
 #[derive(Debug, Clone)]
-struct Surface {
+pub(super) struct Surface {
     rows: usize,
     cols: usize,
     /// Per cell: x then y coefficients, `c[i * 4 + j]` for `u^i v^j`.
@@ -50,7 +50,7 @@ struct Surface {
 }
 
 impl Surface {
-    fn new(mesh: &Mesh) -> Surface {
+    pub(super) fn new(mesh: &Mesh) -> Surface {
         let (rows, cols) = (mesh.rows(), mesh.cols());
         // Phantom nodes one step outside continue the border linearly.
         let node = |r: isize, c: isize| -> Vec2 {
@@ -165,7 +165,7 @@ impl Surface {
 
     /// `S(s, r)` alone (no derivatives): where a located point samples.
     #[inline]
-    fn position(&self, s: f64, r: f64) -> Vec2 {
+    pub(super) fn position(&self, s: f64, r: f64) -> Vec2 {
         let (c, k) = self.cell(s, r);
         let (u, v) = (s - c as f64, r - k as f64);
         let cell = &self.coef[k * (self.cols - 1) + c];
@@ -190,7 +190,7 @@ impl Surface {
             .fold(f64::INFINITY, f64::min)
     }
 
-    fn inside_domain(&self, s: f64, r: f64) -> bool {
+    pub(super) fn inside_domain(&self, s: f64, r: f64) -> bool {
         let eps = 1e-9;
         s >= -eps
             && s <= (self.cols - 1) as f64 + eps
@@ -199,7 +199,7 @@ impl Surface {
     }
 
     /// Newton from `(s, r)`; the parameters where `S = p`, if found.
-    fn solve(&self, p: Vec2, mut s: f64, mut r: f64) -> Option<(f64, f64)> {
+    pub(super) fn solve(&self, p: Vec2, mut s: f64, mut r: f64) -> Option<(f64, f64)> {
         let (hi_s, hi_r) = (self.cols as f64, self.rows as f64);
         for _ in 0..MAX_STEPS {
             let (q, du, dv) = self.eval(s, r);
@@ -234,7 +234,7 @@ impl Surface {
     }
 
     /// A starting point: the centre of the cell whose node quad holds `p`.
-    fn start(&self, p: Vec2) -> Option<(f64, f64)> {
+    pub(super) fn start(&self, p: Vec2) -> Option<(f64, f64)> {
         let (lo, hi) = self.bounds;
         if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
             return None;

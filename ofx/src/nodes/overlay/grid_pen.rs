@@ -1,12 +1,13 @@
 //! The pen on the mesh: a node grabbed alone or with the selection,
 //! Shift- or Ctrl-click adding a node to the selection or taking it out,
-//! a rubber band in empty space selecting the nodes inside it, and Delete
+//! a rubber band in empty space selecting the nodes inside it, Delete
 //! putting the selected (else the hovered) nodes back where the other
-//! side has them.
+//! side has them, and rows and columns added (Shift+Ctrl-click, or the
+//! buttons at the last point clicked on the grid) or removed.
 
 use morphfx::features::Side;
 use morphfx::geom::Vec2;
-use morphfx::warp::mesh::Node;
+use morphfx::warp::mesh::{Line, Node};
 
 use super::grid::{node_at, Grid};
 use super::shapes::{self, refused};
@@ -130,4 +131,107 @@ pub(super) fn reset(
     let done = matches!(result, Ok(true));
     shapes::settle(instance, effect, result.map(|_| ()))?;
     Ok(done)
+}
+
+/// Where rows and columns go: the last pen down on the grid, and on which
+/// side.
+pub(super) fn remember_point(instance: &NodeState, side: Side, at: Vec2) {
+    instance.overlay.locked().grid_point = Some((side, at));
+}
+
+/// Shift+Ctrl-click inside the grid: a line through the pen, a row where
+/// the pen is nearer a column line than a row line (a row crosses the
+/// columns there), else a column. One undo step.
+pub(super) fn add_at_pen(
+    instance: &NodeState,
+    effect: &EffectHandle,
+    side: Side,
+    pen: Pen,
+) -> Outcome {
+    remember_point(instance, side, pen.at);
+    let result = shapes::document(instance, pen.time).and_then(|doc| {
+        let pair = doc.scene().mesh_at(pen.time);
+        let (s, r) = pair.and_then(|p| p.locate(side, pen.at)).ok_or_else(|| {
+            Failure::BadInput(
+                "Shift+Ctrl-click inside the grid to add a row or column there".into(),
+            )
+        })?;
+        let line = if (s - s.round()).abs() < (r - r.round()).abs() {
+            Line::Row
+        } else {
+            Line::Column
+        };
+        add(instance, doc, (side, pen.at), pen.time, line)
+    });
+    shapes::settle(instance, effect, result)
+}
+
+/// The Add Row and Add Column buttons: a line through the last point
+/// clicked on the grid.
+pub fn add_line(instance: &NodeState, effect: &EffectHandle, time: f64, line: Line) -> Outcome {
+    let point = instance.overlay.locked().grid_point;
+    let result = match point {
+        Some(at) => {
+            shapes::document(instance, time).and_then(|doc| add(instance, doc, at, time, line))
+        }
+        None => Err(Failure::BadInput(format!(
+            "Add {}: click the grid in the viewer where it goes first",
+            title(line)
+        ))),
+    };
+    shapes::settle(instance, effect, result)
+}
+
+/// The Remove Row and Remove Column buttons: the line nearest the last
+/// point clicked on the grid (a border one stays).
+pub fn remove_line(instance: &NodeState, effect: &EffectHandle, time: f64, line: Line) -> Outcome {
+    let point = instance.overlay.locked().grid_point;
+    let result = shapes::document(instance, time).and_then(|mut doc| {
+        let located = point.and_then(|(side, at)| doc.scene().mesh_at(time)?.locate(side, at));
+        let Some((s, r)) = located else {
+            return Err(Failure::BadInput(format!(
+                "Remove {}: click the grid in the viewer on the one to remove first",
+                title(line)
+            )));
+        };
+        let index = match line {
+            Line::Row => r,
+            Line::Column => s,
+        };
+        doc.remove_grid_line(line, index.round() as usize)
+            .map_err(refused)?;
+        instance
+            .params()
+            .edit_block(&format!("Remove {}", title(line)), || {
+                shapes::write(instance, &doc)
+            })?;
+        instance.overlay.locked().grid_selection = None;
+        Ok(())
+    });
+    shapes::settle(instance, effect, result)
+}
+
+fn add(
+    instance: &NodeState,
+    mut doc: morphfx::scene::edit::Document,
+    (side, at): (Side, Vec2),
+    time: f64,
+    line: Line,
+) -> Outcome {
+    doc.add_grid_line(time, side, at, line).map_err(refused)?;
+    instance
+        .params()
+        .edit_block(&format!("Add {}", title(line)), || {
+            shapes::write(instance, &doc)
+        })?;
+    // Node indices moved: a selection would name other nodes now.
+    instance.overlay.locked().grid_selection = None;
+    Ok(())
+}
+
+fn title(line: Line) -> &'static str {
+    match line {
+        Line::Row => "Row",
+        Line::Column => "Column",
+    }
 }

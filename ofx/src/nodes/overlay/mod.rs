@@ -16,6 +16,7 @@ pub mod shapes;
 mod state;
 mod view;
 
+pub use grid_pen::{add_line, remove_line};
 pub use pen::{down as pen_down, key_down, motion as pen_motion, up as pen_up};
 pub use state::State;
 pub use view::draw;

@@ -50,6 +50,14 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
     if sides.is_empty() {
         return Ok(Reply::Default);
     }
+    let (shift, ctrl) = {
+        let state = instance.overlay.locked();
+        (state.shift, state.ctrl)
+    };
+    if on_grid && shift && ctrl {
+        grid_pen::add_at_pen(instance, effect, sides[0], pen)?;
+        return Ok(Reply::Done);
+    }
     let drag = match handle {
         Some((h, outlines)) => match h.owner {
             Owner::Slot(slot) => {
@@ -65,7 +73,10 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
                 Err(why) => return refuse(instance, effect, why),
             },
             Owner::Grid => match grid_pen::grab(instance, h, pen) {
-                Ok(Some(drag)) => drag,
+                Ok(Some(drag)) => {
+                    grid_pen::remember_point(instance, h.side, pen.at);
+                    drag
+                }
                 // A Shift- or Ctrl-click chose the node: nothing to drag.
                 Ok(None) => return Ok(Reply::Done),
                 Err(why) => return refuse(instance, effect, why),
@@ -73,7 +84,10 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
             Owner::File(_) => return Ok(Reply::Default),
         },
         // Over the grid, empty space is where a rubber band starts.
-        None if on_grid => grid_pen::start_band(instance, pen),
+        None if on_grid => {
+            grid_pen::remember_point(instance, sides[0], pen.at);
+            grid_pen::start_band(instance, pen)
+        }
         None => match tool {
             DrawTool::Line => match start_new_line(instance, pen)? {
                 Some(drag) => drag,

@@ -55,6 +55,9 @@ pub struct State {
     /// The grid nodes selected, all on one side: a drag of one of them
     /// moves them all, Delete resets them.
     pub(super) grid_selection: Option<(Side, Vec<Node>)>,
+    /// The last pen down on the grid and its side: where Add Row and its
+    /// kin act.
+    pub(super) grid_point: Option<(Side, Vec2)>,
     /// An edit was refused and its message is on the node.
     pub(super) refused: bool,
     pub(super) shift: bool,

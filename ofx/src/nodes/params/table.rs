@@ -214,6 +214,39 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
                 (),
             )
             .in_group(&MESH_GROUP),
+        ADD_ROW
+            .spec(
+                "Add Row",
+                "Adds a row of nodes through the point last clicked on the grid in \
+            the viewer, on A and B where the grid's splines pass there (Shift+Ctrl-click \
+            near a column line does the same at the pen).",
+                (),
+            )
+            .in_group(&MESH_GROUP),
+        ADD_COLUMN
+            .spec(
+                "Add Column",
+                "Adds a column of nodes through the point last clicked on the grid \
+            (Shift+Ctrl-click near a row line does the same at the pen).",
+                (),
+            )
+            .in_group(&MESH_GROUP),
+        REMOVE_ROW
+            .spec(
+                "Remove Row",
+                "Removes the row of nodes nearest the point last clicked on the grid \
+            (not a border row).",
+                (),
+            )
+            .in_group(&MESH_GROUP),
+        REMOVE_COLUMN
+            .spec(
+                "Remove Column",
+                "Removes the column of nodes nearest the point last clicked on the \
+            grid (not a border column).",
+                (),
+            )
+            .in_group(&MESH_GROUP),
         AUTO_GROUP.spec(
             "Auto",
             "Automatic correspondence by work minimisation (method auto)",
