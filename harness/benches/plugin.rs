@@ -190,15 +190,6 @@ fn morph_1080p(bundle: &Bundle) -> morphfx_harness::host::Instance<'_> {
 
 fn bench_overlay(c: &mut Criterion) {
     let text = shapes_json();
-    let mut g = c.benchmark_group("overlay_60_shapes_x20_points");
-    g.sample_size(20).measurement_time(Duration::from_secs(5));
-    g.bench_function("peer_parse_scene_text_json", |bch| {
-        bch.iter(|| black_box(serde_json::from_str::<serde_json::Value>(&text).unwrap()))
-    });
-    let bundle = overlay_bundle();
-    let inst = morph_1080p(&bundle);
-    inst.set_string("scene_text", &text).unwrap();
-    let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
     // A drag of one control point: each motion edits and writes Scene
     // Text, then the viewer redraws.
     let start = {
@@ -206,6 +197,21 @@ fn bench_overlay(c: &mut Criterion) {
         let p = &v["features"][0]["a"][0];
         (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
     };
+    bench_scene_text_overlay(c, "overlay_60_shapes_x20_points", &text, start);
+}
+
+/// Scene Text `text` parsed (the peer), then its overlay drawn, hovered
+/// and dragged from `start`, in a 1080p Morph node.
+fn bench_scene_text_overlay(c: &mut Criterion, group: &str, text: &str, start: (f64, f64)) {
+    let mut g = c.benchmark_group(group);
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    g.bench_function("peer_parse_scene_text_json", |bch| {
+        bch.iter(|| black_box(serde_json::from_str::<serde_json::Value>(text).unwrap()))
+    });
+    let bundle = overlay_bundle();
+    let inst = morph_1080p(&bundle);
+    inst.set_string("scene_text", text).unwrap();
+    let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
     draw_hover_and_drag(&mut g, &ov, start);
     g.finish();
 }
@@ -324,20 +330,9 @@ fn grid_json() -> String {
 }
 
 fn bench_overlay_grid(c: &mut Criterion) {
-    let text = grid_json();
-    let mut g = c.benchmark_group("overlay_grid_32x32");
-    g.sample_size(20).measurement_time(Duration::from_secs(5));
-    g.bench_function("peer_parse_scene_text_json", |bch| {
-        bch.iter(|| black_box(serde_json::from_str::<serde_json::Value>(&text).unwrap()))
-    });
-    let bundle = overlay_bundle();
-    let inst = morph_1080p(&bundle);
-    inst.set_string("scene_text", &text).unwrap();
-    let ov = Overlay::new(&inst, true).unwrap().expect("an overlay");
     // A's node (row 10, col 10).
     let start = (W as f64 * 10.0 / 31.0, H as f64 * 10.0 / 31.0);
-    draw_hover_and_drag(&mut g, &ov, start);
-    g.finish();
+    bench_scene_text_overlay(c, "overlay_grid_32x32", &grid_json(), start);
 }
 
 criterion_main!(benches);

@@ -334,6 +334,31 @@ fn covered_shot(
     })
 }
 
+/// `text` into Scene Text, Track Forward pressed: one write in one undo
+/// step; the scene it wrote.
+fn track_scene_text(
+    inst: &morphfx_harness::host::Instance<'_>,
+    text: &str,
+) -> morphfx::scene::Scene {
+    inst.set_string("scene_text", text).unwrap();
+    morphfx_harness::host::params::take_edit_log();
+    inst.instance_changed("track_forward", 0.0).unwrap();
+    let log = morphfx_harness::host::params::take_edit_log();
+    assert_eq!(log, ["begin Track Forward", "set scene_text", "end"]);
+    morphfx::scene::Scene::read(&inst.string("scene_text").unwrap()).unwrap()
+}
+
+/// A Morph node with the same float shot of `motion` on both sources.
+fn morph_on(motion: &ShotMotion) -> morphfx_harness::host::Instance<'static> {
+    let inst = common::bundle()
+        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
+        .unwrap();
+    let source = shot("OfxBitDepthFloat", motion);
+    inst.connect("SourceA", source.clone()).unwrap();
+    inst.connect("SourceB", source).unwrap();
+    inst
+}
+
 fn point_at(inst: &morphfx_harness::host::Instance<'_>, id: &str, t: f64) -> Vec2 {
     let v = inst.doubles_at(id, t).unwrap();
     Vec2::new(v[0], v[1])
@@ -466,12 +491,7 @@ fn track_keys_no_further_than_a_line_is_seen_and_names_where_it_lost_it() {
 #[test]
 fn track_forward_keys_scene_text_shapes_at_every_frame_in_one_write() {
     let motion = button_motion();
-    let inst = common::bundle()
-        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-        .unwrap();
-    let source = shot("OfxBitDepthFloat", &motion);
-    inst.connect("SourceA", source.clone()).unwrap();
-    inst.connect("SourceB", source).unwrap();
+    let inst = morph_on(&motion);
     // A static scene: a closed curve through four points, and a point.
     let curve_a = [(60.0, 50.0), (120.0, 55.0), (125.0, 100.0), (65.0, 105.0)];
     let curve_b = [(70.0, 60.0), (110.0, 50.0), (130.0, 95.0), (60.0, 110.0)];
@@ -487,12 +507,7 @@ fn track_forward_keys_scene_text_shapes_at_every_frame_in_one_write() {
         json(&curve_a),
         json(&curve_b)
     );
-    inst.set_string("scene_text", &text).unwrap();
-    morphfx_harness::host::params::take_edit_log();
-    inst.instance_changed("track_forward", 0.0).unwrap();
-    let log = morphfx_harness::host::params::take_edit_log();
-    assert_eq!(log, ["begin Track Forward", "set scene_text", "end"]);
-    let scene = morphfx::scene::Scene::read(&inst.string("scene_text").unwrap()).unwrap();
+    let scene = track_scene_text(&inst, &text);
     let frames: Vec<f64> = scene.keyframes.iter().map(|k| k.frame).collect();
     assert_eq!(frames, (0..=10).map(f64::from).collect::<Vec<_>>());
     let v = |(x, y): (f64, f64)| Vec2::new(x, y);
@@ -586,12 +601,7 @@ fn suggest_features_adds_sure_pairs_to_scene_text_and_cancel_adds_none() {
 #[test]
 fn track_forward_carries_the_grids_nodes_with_the_picture() {
     let motion = button_motion();
-    let inst = common::bundle()
-        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-        .unwrap();
-    let source = shot("OfxBitDepthFloat", &motion);
-    inst.connect("SourceA", source.clone()).unwrap();
-    inst.connect("SourceB", source).unwrap();
+    let inst = morph_on(&motion);
     let (rows, cols) = (5usize, 5usize);
     let node = |r: usize, c: usize| Vec2::new(48.0 * c as f64, 40.0 * r as f64);
     let a: Vec<Vec2> = (0..rows * cols).map(|i| node(i / cols, i % cols)).collect();
@@ -603,12 +613,7 @@ fn track_forward_carries_the_grids_nodes_with_the_picture() {
     let text = serde_json::json!({"format": "morphfx-scene", "version": 1, "method": "mesh",
         "mesh": {"rows": rows, "cols": cols, "a": list(&a), "b": list(&b)}})
     .to_string();
-    inst.set_string("scene_text", &text).unwrap();
-    morphfx_harness::host::params::take_edit_log();
-    inst.instance_changed("track_forward", 0.0).unwrap();
-    let log = morphfx_harness::host::params::take_edit_log();
-    assert_eq!(log, ["begin Track Forward", "set scene_text", "end"]);
-    let scene = morphfx::scene::Scene::read(&inst.string("scene_text").unwrap()).unwrap();
+    let scene = track_scene_text(&inst, &text);
     let frames: Vec<f64> = scene.meshes.iter().map(|m| m.0).collect();
     assert_eq!(frames, (0..=10).map(f64::from).collect::<Vec<_>>());
     let mut worst = 0.0f64;

@@ -200,13 +200,7 @@ pub fn remove_line(instance: &NodeState, effect: &EffectHandle, time: f64, line:
         };
         doc.remove_grid_line(line, index.round() as usize)
             .map_err(refused)?;
-        instance
-            .params()
-            .edit_block(&format!("Remove {}", title(line)), || {
-                shapes::write(instance, &doc)
-            })?;
-        instance.overlay.locked().grid_selection = None;
-        Ok(())
+        write_reshaped(instance, &doc, &format!("Remove {}", title(line)))
     });
     shapes::settle(instance, effect, result)
 }
@@ -219,11 +213,18 @@ fn add(
     line: Line,
 ) -> Outcome {
     doc.add_grid_line(time, side, at, line).map_err(refused)?;
+    write_reshaped(instance, &doc, &format!("Add {}", title(line)))
+}
+
+/// A mesh with a line more or less into Scene Text, one undo step.
+fn write_reshaped(
+    instance: &NodeState,
+    doc: &morphfx::scene::edit::Document,
+    label: &str,
+) -> Outcome {
     instance
         .params()
-        .edit_block(&format!("Add {}", title(line)), || {
-            shapes::write(instance, &doc)
-        })?;
+        .edit_block(label, || shapes::write(instance, doc))?;
     // Node indices moved: a selection would name other nodes now.
     instance.overlay.locked().grid_selection = None;
     Ok(())

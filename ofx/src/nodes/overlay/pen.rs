@@ -9,9 +9,11 @@ use morphfx::geom::Vec2;
 
 use super::hit;
 
+use super::grid::Grid;
 use super::grid_pen;
+use super::outline::Outline;
 use super::shapes::{self, refused};
-use super::state::{editable, pixel_of, Building, Drag, Handle, Owner, Part};
+use super::state::{editable, pixel_of, Building, Drag, Handle, Owner, Part, State};
 use super::view::grabbable;
 use crate::nodes::lines::{self, end_id};
 use crate::nodes::params::{slot_ids, DrawTool, Reader, DRAW_TOOL, LINE_COUNT, LINE_SLOTS};
@@ -36,16 +38,13 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
     let tool: DrawTool = r.choice(&DRAW_TOOL);
     let (handle, sides, on_grid) = {
         let state = instance.overlay.locked();
-        let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
-        let (outlines, grid) = grabbable(instance, &r, pen.time);
-        let handle = hit::hit(
-            &outlines,
-            grid.as_ref(),
-            pen.at,
-            pixel_of(&state, &pen),
-            &sides,
-        );
-        (handle.map(|h| (h, outlines)), sides, grid.is_some())
+        let under = under_pen(instance, &r, &state, pen);
+        let on_grid = under.grid.is_some();
+        (
+            under.handle.map(|h| (h, under.outlines)),
+            under.sides,
+            on_grid,
+        )
     };
     if sides.is_empty() {
         return Ok(Reply::Default);
@@ -112,6 +111,33 @@ pub fn down(instance: &NodeState, effect: &EffectHandle, pen: Pen) -> Outcome<Re
         return refuse(instance, effect, why);
     }
     Ok(Reply::Done)
+}
+
+/// What the pen is over: the sides it may grab, everything grabbable,
+/// and the handle under it.
+struct UnderPen {
+    sides: Vec<Side>,
+    outlines: Vec<Outline>,
+    grid: Option<Grid>,
+    handle: Option<Handle>,
+}
+
+fn under_pen(instance: &NodeState, r: &Reader<'_>, state: &State, pen: Pen) -> UnderPen {
+    let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), state);
+    let (outlines, grid) = grabbable(instance, r, pen.time);
+    let handle = hit::hit(
+        &outlines,
+        grid.as_ref(),
+        pen.at,
+        pixel_of(state, &pen),
+        &sides,
+    );
+    UnderPen {
+        sides,
+        outlines,
+        grid,
+        handle,
+    }
 }
 
 /// Shows why an edit was refused, and traps the event (nothing else
@@ -309,15 +335,7 @@ pub fn motion(
     }
     let r = Reader::new(instance.params(), instance.kind, pen.time);
     let mut state = instance.overlay.locked();
-    let sides = editable(r.choice(&OVERLAY_EDIT), r.choice(&OVERLAY_SHOW), &state);
-    let (outlines, grid) = grabbable(instance, &r, pen.time);
-    let hover = hit::hit(
-        &outlines,
-        grid.as_ref(),
-        pen.at,
-        pixel_of(&state, &pen),
-        &sides,
-    );
+    let hover = under_pen(instance, &r, &state, pen).handle;
     // While a shape is drawn, every motion moves its rubber band.
     let building = match state.building.as_mut() {
         Some(b) => {
