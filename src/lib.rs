@@ -21,6 +21,7 @@ pub mod image;
 pub mod make_warp;
 pub mod morph;
 pub mod scene;
+pub mod shutter;
 pub mod snake;
 pub mod strokes;
 pub mod suggest;

@@ -9,6 +9,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("geom", 0),
     ("choice", 0),
+    ("shutter", 1),
     ("strokes", 1),
     ("features", 1),
     ("bspline", 1),

@@ -3,6 +3,7 @@
 //! an id is checked when the plugin is compiled.
 
 use morphfx::image::{EdgeMode, Filter};
+use morphfx::shutter::ShutterOffset;
 use morphfx::warp::field::LineInterpolation;
 use morphfx::warp::mesh::Pass;
 
@@ -69,6 +70,9 @@ pub const TRANSITION_ANGLE: Id<Double> = Id::new("transition_angle");
 pub const TRANSITION_CYCLES: Id<Double> = Id::new("transition_cycles");
 pub const MASK_INVERT: Id<Bool> = Id::new("mask_invert");
 pub const MIX: Id<Double> = Id::new("mix");
+pub const MOTION_BLUR: Id<Int> = Id::new("motion_blur");
+pub const SHUTTER: Id<Double> = Id::new("shutter");
+pub const SHUTTER_OFFSET: Id<Choose<ShutterOffset>> = Id::new("shutter_offset");
 
 /// The groups, as hosts fold them.
 pub const FIELD_GROUP: Id<Group> = Id::new("field_group");
@@ -78,6 +82,7 @@ pub const SCATTERED_GROUP: Id<Group> = Id::new("scattered_group");
 pub const TRANSITION_GROUP: Id<Group> = Id::new("transition_group");
 pub const LINES_GROUP: Id<Group> = Id::new("lines_group");
 pub const SCENE_GROUP: Id<Group> = Id::new("scene_group");
+pub const MOTION_BLUR_GROUP: Id<Group> = Id::new("motion_blur_group");
 
 /// The group holding line slot `k`'s params.
 pub fn slot_group(k: usize) -> Id<Group> {

@@ -3,6 +3,7 @@
 use morphfx::features::Feature;
 use morphfx::image::{EdgeMode, Filter};
 use morphfx::make_warp::MethodSettings;
+use morphfx::shutter::Shutter;
 use morphfx::transition::procedural::PatternKind;
 use morphfx::transition::{Pattern, Procedural, Transition, TransitionSettings};
 use morphfx::views::View;
@@ -45,6 +46,8 @@ pub struct Settings {
     pub mix: f64,
     /// The Mask input's alpha is read inverted.
     pub mask_invert: bool,
+    /// Motion blur: samples, shutter length and offset.
+    pub shutter: Shutter,
     pub missing: Vec<String>,
     /// Why each param the host has could not be read.
     pub unreadable: Vec<String>,
@@ -108,6 +111,11 @@ impl Settings {
             affects: r.choice(&TRANSITION_AFFECTS),
             spread: r.double(&TRANSITION_SPREAD),
             mix: r.double(&MIX),
+            shutter: Shutter {
+                samples: r.int(&MOTION_BLUR).max(0) as usize,
+                length: r.double(&SHUTTER),
+                offset: r.choice(&SHUTTER_OFFSET),
+            },
             mask_invert: r.bool(&MASK_INVERT),
             missing: Vec::new(),
             unreadable: Vec::new(),

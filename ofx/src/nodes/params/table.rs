@@ -8,6 +8,7 @@ use std::sync::{Mutex, OnceLock};
 use morphfx::choice::Choice;
 use morphfx::image::{EdgeMode, Filter};
 use morphfx::make_warp::Method;
+use morphfx::shutter::ShutterOffset;
 use morphfx::suggest::SuggestSettings;
 use morphfx::warp::auto::grid::MAX_LEVEL;
 use morphfx::warp::auto::Coefficients;
@@ -711,6 +712,47 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
                 display: (0.0, 1.0),
             },
         ),
+        MOTION_BLUR_GROUP.spec(
+            "Motion Blur",
+            "The warp's motion within the shutter, as the picture views show it",
+            false,
+        ),
+        MOTION_BLUR
+            .spec(
+                "Motion Blur",
+                "Renders averaged over the shutter (0: off). With N, the picture is \
+            the mean of the node rendered at N times evenly spread over the \
+            shutter (the features, mesh, progress and params at each time; the \
+            sources held at the frame). A still scene renders once.",
+                Ints {
+                    default: 0,
+                    min: 0,
+                    max: 64,
+                },
+            )
+            .in_group(&MOTION_BLUR_GROUP)
+            .animated(false),
+        SHUTTER
+            .spec(
+                "Shutter",
+                "How long the shutter is open, in frames.",
+                Doubles {
+                    default: 0.5,
+                    min: 0.0,
+                    max: 10.0,
+                    display: (0.0, 2.0),
+                },
+            )
+            .in_group(&MOTION_BLUR_GROUP),
+        SHUTTER_OFFSET
+            .spec(
+                "Shutter Offset",
+                "Where the shutter opens: centred on the frame, starting at it, or \
+            ending at it.",
+                ShutterOffset::Centred,
+            )
+            .in_group(&MOTION_BLUR_GROUP)
+            .animated(false),
     ]);
     t
 }

@@ -76,6 +76,7 @@ const RELEASED_BOTH: &[(&str, &[&str])] = &[
     ),
     ("overlay_edit", &["A and B", "A only", "B only"]),
     ("draw_tool", &["line", "point", "polyline", "curve"]),
+    ("shutter_offset", &["centred", "start", "end"]),
 ];
 
 fn released() -> Vec<(&'static NodeKind, &'static str, &'static [&'static str])> {

@@ -40,9 +40,9 @@ pub(super) fn timing_matte(image: &HostImage) -> Outcome<Matte> {
 /// The transitions with the timing matte in place of the node's pattern
 /// (and a scene's curves): what Affects names is paced by the matte, the
 /// rest stays uniform.
-pub(super) fn timed(matte: Matte, settings: &Settings) -> TransitionSettings {
+pub(super) fn timed(matte: Arc<Matte>, settings: &Settings) -> TransitionSettings {
     let t = Transition::Matte {
-        matte: Arc::new(matte),
+        matte,
         spread: settings.spread,
     };
     pacing(t, settings.affects)

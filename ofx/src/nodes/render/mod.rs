@@ -12,11 +12,13 @@ use std::sync::Arc;
 
 use morphfx::features::Side;
 use morphfx::geom::{PixelScale, RectD, RectI, Vec2};
-use morphfx::image::{EdgeMode, Filter, Image, ImageView, Layout, Sampler, WarpMap};
+use morphfx::image::{
+    EdgeMode, Filter, Image, ImageView, Layout, RowsMut, Sample, Sampler, WarpMap,
+};
 use morphfx::make_warp::{self, Method};
 use morphfx::morph::mix::{mask_plane, mix, Mix};
 use morphfx::morph::Warped;
-use morphfx::transition;
+use morphfx::transition::{self, Matte};
 use morphfx::views::View;
 use morphfx::warp::auto::WorkImage;
 use morphfx::warp::mesh::Pass;
@@ -55,6 +57,7 @@ macro_rules! with_depth {
     };
 }
 
+mod blur;
 mod mattes;
 
 /// The render action: gather, prepare, draw.
@@ -63,6 +66,9 @@ pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) ->
     let (mut request, mut lent) = gather(instance, effect, args)?;
     if effect.aborted() {
         return Ok(());
+    }
+    if let Some(samples) = blur::samples(instance, effect, &request)? {
+        return blur::render(kind, instance, effect, samples, &mut lent);
     }
     correspond(instance, &mut request)?;
     let job = prepare(kind, instance, &request)?;
@@ -101,7 +107,37 @@ struct Request {
     /// The rectangle ST maps are normalised by, as (origin, size).
     project: (Vec2, Vec2),
     /// Both sources as `auto` work images (method `auto` only).
-    work: Option<[WorkImage; 2]>,
+    work: Option<Arc<[WorkImage; 2]>>,
+    /// The Timing input's matte (Morph node, connected).
+    timing: Option<Arc<Matte>>,
+}
+
+impl Request {
+    /// This render's request with the params, the scene and so the warps
+    /// taken at `time` instead (the images stay the frame's): one sample of
+    /// a motion-blurred frame.
+    fn at(
+        &self,
+        kind: &'static NodeKind,
+        effect: &EffectHandle,
+        instance: &NodeState,
+        time: f64,
+    ) -> Outcome<Request> {
+        let settings = read_settings(kind, effect, instance, time)?;
+        let mut inputs = warp_inputs(instance, &settings, time)?;
+        if let Some(matte) = &self.timing {
+            inputs.warp.settings.transition = mattes::timed(matte.clone(), &settings);
+        }
+        inputs.warp.region = self.inputs.warp.region;
+        Ok(Request {
+            time,
+            settings,
+            inputs,
+            work: self.work.clone(),
+            timing: self.timing.clone(),
+            ..*self
+        })
+    }
 }
 
 /// The host's images one render holds: sources A and B, the mask (picture
@@ -154,10 +190,12 @@ fn gather(
         Some(b) => source(effect, b, time + settings.offset_b as f64)?,
         None => None,
     };
+    let mut timing = None;
     if kind.has_b() {
         if let Some(image) = source(effect, TIMING_CLIP, time)? {
-            let matte = mattes::timing_matte(&image)?;
-            inputs.warp.settings.transition = mattes::timed(matte, &settings);
+            let matte = Arc::new(mattes::timing_matte(&image)?);
+            inputs.warp.settings.transition = mattes::timed(matte.clone(), &settings);
+            timing = Some(matte);
         }
     }
     let mask = if settings.view.is_picture() {
@@ -188,7 +226,7 @@ fn gather(
         })
     });
     let work = match inputs.warp.method() {
-        Method::Auto => Some(work_images(&a, &b, depth)?),
+        Method::Auto => Some(Arc::new(work_images(&a, &b, depth)?)),
         _ => None,
     };
     let request = Request {
@@ -203,6 +241,7 @@ fn gather(
         out_scale,
         project: regions::project(effect, &rod),
         work,
+        timing,
     };
     let lent = Lent {
         sources: [a, b],
@@ -284,7 +323,7 @@ fn canonical(bounds: RectI, scale: PixelScale) -> RectD {
 /// Method `auto`: the correspondence of the two work images, which the
 /// maps are then made from like any method's.
 fn correspond(instance: &NodeState, request: &mut Request) -> Outcome {
-    if let Some([a, b]) = &request.work {
+    if let Some([a, b]) = request.work.as_deref() {
         let covers = |k: usize| request.sources[k].map_or(RectD::default(), |s| s.covers);
         let c = warm::correspondence(
             instance,
@@ -499,8 +538,23 @@ fn view_of<'a, S: HostSample>(
 /// Writes the render window of the output: samplers over the lent sources
 /// at their depth, rows of the output at its own.
 fn draw(kind: &NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> Outcome {
+    let mask = lent.mask.as_ref().map(mask_of).transpose()?;
+    with_depth!(lent.out.info().depth, D => {
+        let rows = lent.out.rows_mut::<D>(request.window)?;
+        draw_rows(kind, job, request, (&lent.sources, &mask), rows)
+    })
+}
+
+/// [`draw`] into `rows` (the output's, or a motion blur sample's).
+fn draw_rows<D: Sample>(
+    kind: &NodeKind,
+    job: &Job<'_>,
+    request: &Request,
+    (sources, mask): (&[Option<HostImage>; 2], &Option<MaskPlane<'_>>),
+    rows: RowsMut<'_, D>,
+) -> Outcome {
     let settings = &request.settings;
-    let [a, b] = &lent.sources;
+    let [a, b] = sources;
     let sampler_parts = |k: usize, s: &Option<HostImage>| {
         let source = request.sources[k];
         (
@@ -516,10 +570,8 @@ fn draw(kind: &NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> O
     };
     let ((a_scale, a_edge, a_pre), (b_scale, b_edge, b_pre)) =
         (sampler_parts(0, a), sampler_parts(1, b));
-    let mask = lent.mask.as_ref().map(mask_of).transpose()?;
     let mixed = settings.view.is_picture() && (settings.mix < 1.0 || mask.is_some());
-    with_depth!(lent.out.info().depth, D => {
-        let rows = lent.out.rows_mut::<D>(request.window)?;
+    {
         with_depth!(request.depth, S => {
             let black = [S::default(); 4];
             let src = view_of::<S>(a, &black)?;
@@ -546,7 +598,7 @@ fn draw(kind: &NodeKind, job: &Job<'_>, request: &Request, lent: &mut Lent) -> O
             };
             mix(&effect, &how, rows);
         })
-    });
+    }
     Ok(())
 }
 
@@ -608,6 +660,7 @@ mod tests {
             out_scale: PixelScale::UNIT,
             project: (Vec2::new(0.0, 0.0), Vec2::new(64.0, 48.0)),
             work: None,
+            timing: None,
         }
     }
 

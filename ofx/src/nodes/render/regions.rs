@@ -156,20 +156,18 @@ pub fn is_identity(
     args: &RenderArgs,
 ) -> Outcome<Option<Identity>> {
     let time = args.time;
-    let settings = Settings::read(node.params(), time, node.kind);
-    let inputs = warp_inputs(node, &settings, time)?;
-    // A mask or a mix below 1 dials a picture back toward source A: the
-    // output is A where the effect is, or where none of it reaches.
-    let picture = settings.view.is_picture();
-    let masked = picture && (settings.mix < 1.0 || effect.clip(MASK_CLIP)?.is_connected());
-    let side = if picture && settings.mix <= 0.0 {
-        Some(Side::A)
-    } else {
-        identity_side(node.kind, settings.view, &inputs).filter(|s| !masked || *s == Side::A)
-    };
+    let (side, settings) = side_at(node, effect, time)?;
     let Some(side) = side else {
         return Ok(None);
     };
+    // Motion blur: the frame is one source only if every sample is.
+    if settings.view.is_picture() {
+        for t in settings.shutter.times(time) {
+            if t != time && side_at(node, effect, t)?.0 != Some(side) {
+                return Ok(None);
+            }
+        }
+    }
     let (a, b) = node.kind.source_clips(node.context);
     let (clip, offset) = match (side, b) {
         (Side::B, Some(b)) => (b, settings.offset_b),
@@ -182,6 +180,27 @@ pub fn is_identity(
         clip,
         time: time + offset as f64,
     }))
+}
+
+/// Which source the output is at `time`, when it is one unchanged, with
+/// the params there.
+fn side_at(
+    node: &NodeState,
+    effect: &EffectHandle,
+    time: f64,
+) -> Outcome<(Option<Side>, Settings)> {
+    let settings = Settings::read(node.params(), time, node.kind);
+    let inputs = warp_inputs(node, &settings, time)?;
+    // A mask or a mix below 1 dials a picture back toward source A: the
+    // output is A where the effect is, or where none of it reaches.
+    let picture = settings.view.is_picture();
+    let masked = picture && (settings.mix < 1.0 || effect.clip(MASK_CLIP)?.is_connected());
+    let side = if picture && settings.mix <= 0.0 {
+        Some(Side::A)
+    } else {
+        identity_side(node.kind, settings.view, &inputs).filter(|s| !masked || *s == Side::A)
+    };
+    Ok((side, settings))
 }
 
 /// Which source the output is at `inputs`' progress, when it is one unchanged.
