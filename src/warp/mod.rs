@@ -5,6 +5,9 @@
 pub mod auto;
 pub mod field;
 pub mod hybrid;
+mod invert;
+
+pub use invert::invert;
 pub mod mesh;
 pub mod mffd;
 pub mod node_grid;

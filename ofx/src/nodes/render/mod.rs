@@ -67,8 +67,8 @@ pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) ->
     if effect.aborted() {
         return Ok(());
     }
-    if let Some(samples) = blur::samples(instance, effect, &request)? {
-        return blur::render(kind, instance, effect, samples, &mut lent);
+    if let Some(samples) = blur_samples(instance, effect, &request)? {
+        return render_blurred(kind, instance, effect, samples, &mut lent);
     }
     correspond(instance, &mut request)?;
     let job = prepare(kind, instance, &request)?;
@@ -76,6 +76,60 @@ pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) ->
         return Ok(());
     }
     draw(kind, &job, &request, &mut lent)
+}
+
+/// Motion blur: the requests of a blurred frame, one per time of the
+/// shutter; `None` when the frame renders once: no blur asked, a view
+/// that is not a picture, or a still scene (every sample's warps and mix
+/// as the frame's). Each sample takes the params, the scene and so the
+/// warps at its time; the source images stay the frame's: it is the
+/// warp's motion that blurs, as an animated distortion's does.
+fn blur_samples(
+    instance: &NodeState,
+    effect: &EffectHandle,
+    request: &Request,
+) -> Outcome<Option<Vec<Request>>> {
+    let times = request.settings.shutter.times(request.time);
+    if times.len() < 2 || !request.settings.view.is_picture() {
+        return Ok(None);
+    }
+    let samples = times
+        .iter()
+        .map(|t| request.at(instance.kind, effect, instance, *t))
+        .collect::<Outcome<Vec<Request>>>()?;
+    let what = |r: &Request| Key::of(&(&r.inputs, r.settings.mix.to_bits()));
+    let frame = what(request);
+    if samples.iter().all(|r| what(r) == frame) {
+        return Ok(None);
+    }
+    Ok(Some(samples))
+}
+
+/// A blurred frame: each sample rendered in float, their mean written to
+/// the output window.
+fn render_blurred(
+    kind: &'static NodeKind,
+    instance: &NodeState,
+    effect: &EffectHandle,
+    samples: Vec<Request>,
+    lent: &mut Lent,
+) -> Outcome {
+    let window = samples[0].window;
+    let mask = lent.mask.as_ref().map(mask_of).transpose()?;
+    let mut mean = blur::Mean::new(window, lent.out.info().channels);
+    for mut request in samples {
+        if effect.aborted() {
+            return Ok(());
+        }
+        correspond(instance, &mut request)?;
+        let job = prepare(kind, instance, &request)?;
+        let mut one = mean.sample();
+        let mut view = one.view_mut();
+        draw_rows::<f32>(kind, &job, &request, (&lent.sources, &mask), view.rows())?;
+        mean.add(&one);
+    }
+    with_depth!(lent.out.info().depth, D => mean.write(lent.out.rows_mut::<D>(window)?));
+    Ok(())
 }
 
 /// A source as [`prepare`] sees it: what its image's properties say.
