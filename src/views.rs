@@ -4,12 +4,13 @@
 
 use crate::choice::Choice;
 use crate::features::{outline, Feature, FeatureKind};
-use crate::geom::Vec2;
+use crate::geom::{PixelScale, Vec2};
 use crate::image::resample::fill_rows;
 use crate::image::WarpMap;
 use crate::image::{resample::fill, Image, RowsMut, Sample};
 use crate::morph::Warped;
 use crate::transition::Rates;
+use crate::warp::{invert, Warp};
 
 /// The output view a node renders (the command line's `--view`, docs/command-line.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -35,6 +36,9 @@ pub enum View {
     /// Where a reverse map folds the image over itself: alpha 1 there, the
     /// morph tinted beneath.
     Folds,
+    /// The warp's motion vectors ([`vectors`]): forward in red and green,
+    /// backward in blue and alpha.
+    Vectors,
 }
 
 impl View {
@@ -56,6 +60,7 @@ impl Choice for View {
         View::Grid,
         View::Ghost,
         View::Folds,
+        View::Vectors,
     ];
     fn name(self) -> &'static str {
         match self {
@@ -68,8 +73,35 @@ impl Choice for View {
             View::Grid => "grid",
             View::Ghost => "ghost",
             View::Folds => "folds",
+            View::Vectors => "vectors",
         }
     }
+}
+
+/// The vectors view, for Nuke's VectorBlur: red and green the forward
+/// motion, in pixels at `scale` (x right, y up), of what each output pixel
+/// shows, from this frame to the next: `v(p) = next⁻¹(now(p)) − p`, where
+/// the next frame shows the source point `now` samples here (the source
+/// held still: the warp's own motion); blue and alpha the backward motion,
+/// to the previous frame (`prev`). Where the point is not found (it
+/// leaves the warp's reach) the motion is 0.
+pub fn vectors<D: Sample>(
+    now: &dyn Warp,
+    next: &dyn Warp,
+    prev: &dyn Warp,
+    scale: PixelScale,
+    dst: RowsMut<'_, D>,
+) {
+    fill(dst, 4, |i, j, px| {
+        let p = scale.pixel_centre(i, j);
+        let source = now.map(p);
+        let motion = |other: &dyn Warp| match invert(other, source, p) {
+            Some(q) => scale.to_pixel(q - p),
+            None => Vec2::ZERO,
+        };
+        let (f, b) = (motion(next), motion(prev));
+        *px = [f.x as f32, f.y as f32, b.x as f32, b.y as f32];
+    });
 }
 
 /// ST map (Nuke STMap convention, docs/coordinates.md): red and green hold the source
@@ -238,4 +270,36 @@ pub fn folds<D: Sample>(picture: &Image, maps: &[&WarpMap], dst: RowsMut<'_, D>)
             [p[0], p[1], p[2], 0.0]
         };
     });
+}
+
+#[cfg(test)]
+mod vector_tests {
+    use super::*;
+    use crate::geom::RectI;
+
+    /// A reverse map that samples `shift` away: the picture moves by
+    /// `-shift`.
+    struct Shift(Vec2);
+    impl Warp for Shift {
+        fn map(&self, p: Vec2) -> Vec2 {
+            p + self.0
+        }
+    }
+
+    /// The warp's sampling shift grows by (2, 1) canonical px a frame, so
+    /// the picture moves by (-2, -1) a frame: forward (-2, -1), backward
+    /// (2, 1), in pixels at render scale 0.5 half that.
+    #[test]
+    fn vectors_are_the_pictures_motion_to_the_next_and_previous_frames() {
+        let s = |f: f64| Shift(Vec2::new(2.0, 1.0) * f);
+        let scale = PixelScale::new(0.5, 0.5, 1.0);
+        let mut out = Image::new(RectI::new(0, 0, 6, 4), 4);
+        vectors(&s(5.0), &s(6.0), &s(4.0), scale, out.view_mut().rows());
+        for px in out.data.chunks(4) {
+            let want = [-1.0, -0.5, 1.0, 0.5];
+            for (v, w) in px.iter().zip(want) {
+                assert!((v - w).abs() < 1e-5, "{px:?}");
+            }
+        }
+    }
 }

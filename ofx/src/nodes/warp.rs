@@ -28,7 +28,13 @@ impl Node for Warp {
             Method::Mffd,
             Method::Hybrid,
         ],
-        views: &[View::WarpedA, View::StmapA, View::Grid, View::Folds],
+        views: &[
+            View::WarpedA,
+            View::StmapA,
+            View::Grid,
+            View::Folds,
+            View::Vectors,
+        ],
         view_labels: &[(View::WarpedA, "warped"), (View::StmapA, "stmap")],
     };
 }

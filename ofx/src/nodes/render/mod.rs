@@ -67,6 +67,9 @@ pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) ->
     if effect.aborted() {
         return Ok(());
     }
+    if request.settings.view == View::Vectors {
+        return render_vectors(kind, instance, effect, request, &mut lent);
+    }
     if let Some(samples) = blur_samples(instance, effect, &request)? {
         return render_blurred(kind, instance, effect, samples, &mut lent);
     }
@@ -129,6 +132,35 @@ fn render_blurred(
         mean.add(&one);
     }
     with_depth!(lent.out.info().depth, D => mean.write(lent.out.rows_mut::<D>(window)?));
+    Ok(())
+}
+
+/// The vectors view: the motion of warped A (the Warp node's source) to
+/// the next and the previous frame, from its warps at this frame and
+/// those two (the params and scene there; the images the frame's).
+fn render_vectors(
+    kind: &'static NodeKind,
+    instance: &NodeState,
+    effect: &EffectHandle,
+    mut request: Request,
+    lent: &mut Lent,
+) -> Outcome {
+    let (time, window, scale) = (request.time, request.window, request.out_scale);
+    let mut warp_at = |at: f64| {
+        let mut other = match at == time {
+            true => None,
+            false => Some(request.at(kind, effect, instance, at)?),
+        };
+        let r = other.as_mut().unwrap_or(&mut request);
+        correspond(instance, r)?;
+        let inputs = &r.inputs;
+        make_warp::toward(&inputs.features, Side::A, inputs.t, &inputs.warp).map_err(bad_input)
+    };
+    let (now, next, prev) = (warp_at(time)?, warp_at(time + 1.0)?, warp_at(time - 1.0)?);
+    with_depth!(lent.out.info().depth, D => {
+        let rows = lent.out.rows_mut::<D>(window)?;
+        morphfx::views::vectors(now.as_ref(), next.as_ref(), prev.as_ref(), scale, rows);
+    });
     Ok(())
 }
 

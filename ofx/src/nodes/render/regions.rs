@@ -99,10 +99,11 @@ pub fn clip_preferences(
         }
     }
     out.set_premultiplied_output(straight.is_empty() || !straight.iter().all(|s| *s));
-    // The ghost and folds views put their measure in alpha: an RGB output
-    // (what hosts give RGB sources) would drop it.
+    // The ghost and folds views put their measure in alpha, the vectors
+    // view its backward motion: an RGB output (what hosts give RGB
+    // sources) would drop it.
     let view = Reader::new(node.params(), node.kind, 0.0).pick(&VIEW, node.kind.views);
-    if matches!(view, View::Ghost | View::Folds) {
+    if matches!(view, View::Ghost | View::Folds | View::Vectors) {
         out.set_rgba_output();
     }
     Ok(Reply::Done)
