@@ -72,6 +72,8 @@ pub const MASK_INVERT: Id<Bool> = Id::new("mask_invert");
 pub const MIX: Id<Double> = Id::new("mix");
 pub const MOTION_BLUR: Id<Int> = Id::new("motion_blur");
 pub const SHUTTER: Id<Double> = Id::new("shutter");
+/// The most motion blur samples a render takes (the param's maximum).
+pub const MAX_BLUR_SAMPLES: i32 = 64;
 pub const SHUTTER_OFFSET: Id<Choose<ShutterOffset>> = Id::new("shutter_offset");
 
 /// The groups, as hosts fold them.

@@ -112,7 +112,8 @@ impl Settings {
             spread: r.double(&TRANSITION_SPREAD),
             mix: r.double(&MIX),
             shutter: Shutter {
-                samples: r.int(&MOTION_BLUR).max(0) as usize,
+                // A host that does not clamp to the declared range gets it here.
+                samples: r.int(&MOTION_BLUR).clamp(0, MAX_BLUR_SAMPLES) as usize,
                 length: r.double(&SHUTTER),
                 offset: r.choice(&SHUTTER_OFFSET),
             },

@@ -727,7 +727,7 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
                 Ints {
                     default: 0,
                     min: 0,
-                    max: 64,
+                    max: MAX_BLUR_SAMPLES,
                 },
             )
             .in_group(&MOTION_BLUR_GROUP)
