@@ -19,7 +19,7 @@ use morphfx::warp::thin_plate::ThinPlateSettings;
 
 use crate::nodes::kind::NodeKind;
 use ofx_layer::plugin::Context;
-use ofx_layer::spec::{Doubles, Ints, Options, ParamSpec, TextMode, Texts};
+use ofx_layer::spec::{Doubles, Id, Int, Ints, Options, ParamSpec, TextMode, Texts};
 use ofx_layer::sync::Locked;
 
 use super::choices::{pattern_label, Affects, DrawTool, EditSides, EvaluationMode, Show, PATTERNS};
@@ -180,30 +180,16 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
             )
             .in_group(&MESH_GROUP)
             .animated(false),
-        GRID_ROWS
-            .spec(
-                "Grid Rows",
-                "Rows of nodes Reset Grid makes (a row runs left to right).",
-                Ints {
-                    default: 5,
-                    min: 2,
-                    max: MAX_SIZE as i32,
-                },
-            )
-            .in_group(&MESH_GROUP)
-            .animated(false),
-        GRID_COLS
-            .spec(
-                "Grid Columns",
-                "Columns of nodes Reset Grid makes.",
-                Ints {
-                    default: 5,
-                    min: 2,
-                    max: MAX_SIZE as i32,
-                },
-            )
-            .in_group(&MESH_GROUP)
-            .animated(false),
+        grid_size(
+            &GRID_ROWS,
+            "Grid Rows",
+            "Rows of nodes Reset Grid makes (a row runs left to right).",
+        ),
+        grid_size(
+            &GRID_COLS,
+            "Grid Columns",
+            "Columns of nodes Reset Grid makes.",
+        ),
         RESET_GRID
             .spec(
                 "Reset Grid",
@@ -755,6 +741,18 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
             .animated(false),
     ]);
     t
+}
+
+/// Grid Rows or Grid Columns: 2 to the largest mesh, 5 by default.
+fn grid_size(id: &Id<Int>, label: &'static str, hint: &'static str) -> ParamSpec {
+    let size = Ints {
+        default: 5,
+        min: 2,
+        max: MAX_SIZE as i32,
+    };
+    id.spec(label, hint, size)
+        .in_group(&MESH_GROUP)
+        .animated(false)
 }
 
 /// Line slot `k`'s params, in their own group: enable, the four ends, Clear.
