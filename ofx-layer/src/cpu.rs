@@ -33,6 +33,17 @@ pub struct FastBuild {
 /// Whether this binary itself was compiled for AVX2 + FMA.
 const THIS_IS_FAST: bool = cfg!(all(target_feature = "avx2", target_feature = "fma"));
 
+/// Which build this binary is, as the plugin's description ends: the one
+/// a host's calls reach (the baseline build hands them all to the v3 one
+/// when it can), so a user or a benchmark can tell which code ran.
+pub fn this_build() -> &'static str {
+    if THIS_IS_FAST {
+        "x86-64-v3 build (AVX2 + FMA)"
+    } else {
+        "baseline x86-64 build"
+    }
+}
+
 /// Whether this CPU can run the fast build (baseline code: the detection is
 /// real here, not folded to a constant as it would be in the v3 build).
 fn cpu_has_v3() -> bool {

@@ -18,7 +18,8 @@ pub(super) fn describe<E: ImageEffect>(effect: &EffectHandle) -> Outcome {
     let p = effect.props()?;
     p.set_string(kOfxPropLabel, 0, E::LABEL)?;
     let _ = p.set_string(kOfxPropShortLabel, 0, E::LABEL);
-    let _ = p.set_string(kOfxPropPluginDescription, 0, E::DESCRIPTION);
+    let description = format!("{} ({}.)", E::DESCRIPTION, super::cpu::this_build());
+    let _ = p.set_string(kOfxPropPluginDescription, 0, &description);
     p.set_string(kOfxImageEffectPluginPropGrouping, 0, E::GROUPING)?;
     set_names(
         &p,

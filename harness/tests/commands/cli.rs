@@ -594,6 +594,47 @@ fn bench_drag_times_renders_after_a_move_at_both_scales() {
     assert_eq!(bad.status.code(), Some(2));
 }
 
+/// `morphfx bench --drag` says which build of the plugin ran: the v3 one
+/// where the bundle has it and the CPU runs it, else the baseline one (as
+/// with `MORPHFX_CPU=baseline`, which makes a CPU with AVX2 look like one
+/// without).
+#[test]
+fn bench_drag_says_which_build_of_the_plugin_ran() {
+    let said = |baseline: bool| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_morphfx"));
+        c.arg("--bundle").arg(common::bundle_path());
+        c.args([
+            "bench", "--drag", "--width", "32", "--height", "32", "--moves", "1",
+        ]);
+        if baseline {
+            c.env("MORPHFX_CPU", "baseline");
+        }
+        let run = c.output().unwrap();
+        assert!(run.status.success());
+        String::from_utf8_lossy(&run.stderr).into_owned()
+    };
+    assert!(
+        said(true).contains("the bundle's baseline x86-64 build ran"),
+        "{}",
+        said(true)
+    );
+    let v3 = common::bundle_path()
+        .join("Contents/Linux-x86-64/MorphFX-x86-64-v3.so")
+        .is_file();
+    #[cfg(target_arch = "x86_64")]
+    let cpu =
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
+    #[cfg(not(target_arch = "x86_64"))]
+    let cpu = false;
+    let want = if v3 && cpu {
+        "the bundle's x86-64-v3 build (AVX2 + FMA) ran"
+    } else {
+        "the bundle's baseline x86-64 build ran"
+    };
+    let text = said(false);
+    assert!(text.contains(want), "{text}");
+}
+
 /// Several frames into one file name would overwrite it frame after frame:
 /// refused before anything is rendered, as is a frame named twice.
 #[test]
