@@ -38,7 +38,7 @@ const THIS_IS_FAST: bool = cfg!(all(target_feature = "avx2", target_feature = "f
 /// when it can), so a user or a benchmark can tell which code ran.
 pub fn this_build() -> &'static str {
     if THIS_IS_FAST {
-        "x86-64-v3 build (AVX2 + FMA)"
+        "x86-64-v3 build with AVX2 and FMA"
     } else {
         "baseline x86-64 build"
     }

@@ -627,7 +627,7 @@ fn bench_drag_says_which_build_of_the_plugin_ran() {
     #[cfg(not(target_arch = "x86_64"))]
     let cpu = false;
     let want = if v3 && cpu {
-        "the bundle's x86-64-v3 build (AVX2 + FMA) ran"
+        "the bundle's x86-64-v3 build with AVX2 and FMA ran"
     } else {
         "the bundle's baseline x86-64 build ran"
     };
