@@ -73,7 +73,8 @@ fn run(cli: Cli) -> Result<(), HostError> {
                 ..SnakeSettings::default()
             },
         }
-        .run(),
+        .run()
+        .map(|said| println!("{said}")),
         Command::Suggest {
             a,
             b,
@@ -98,7 +99,8 @@ fn run(cli: Cli) -> Result<(), HostError> {
                 ..SuggestSettings::default()
             },
         }
-        .run(),
+        .run()
+        .map(|said| println!("{said}")),
         Command::Track {
             scene,
             a,

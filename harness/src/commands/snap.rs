@@ -34,7 +34,8 @@ pub struct Snap<'a> {
 }
 
 impl Snap<'_> {
-    pub fn run(&self) -> Result<(), HostError> {
+    /// Refines and writes the scene; returns the line the command prints.
+    pub fn run(&self) -> Result<String, HostError> {
         let text = std::fs::read_to_string(self.scene)
             .map_err(|e| HostError::bad(format!("scene {}: {e}", self.scene.display())))?;
         // The whole scene is validated first; edits go to the JSON itself so
@@ -115,12 +116,11 @@ impl Snap<'_> {
         Scene::parse(&out)
             .map_err(|e| HostError::failed(format!("refined scene is invalid: {e}")))?;
         io::write_text(self.output, &out)?;
-        println!(
+        Ok(format!(
             "snap: refined {refined} polyline/curve feature(s) on both \
                 images (largest move {moved:.2} px) -> {}",
             self.output.display()
-        );
-        Ok(())
+        ))
     }
 
     /// The frame refined: `--frame`, else a scene's only keyframe (there is

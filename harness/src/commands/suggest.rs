@@ -49,7 +49,8 @@ pub struct Suggest<'a> {
 }
 
 impl Suggest<'_> {
-    pub fn run(&self) -> Result<(), HostError> {
+    /// Suggests and writes the scene; returns the line the command prints.
+    pub fn run(&self) -> Result<String, HostError> {
         let base = self.base()?;
         check(&self.settings)?;
         let at = self.frame()?;
@@ -92,14 +93,13 @@ impl Suggest<'_> {
             (lo.min(s.confidence), hi.max(s.confidence))
         });
         let lines = found.iter().filter(|s| s.kind == FeatureKind::Line).count();
-        println!(
+        Ok(format!(
             "suggest: {} pair(s) ({lines} line(s), {} point(s)), confidence {lo:.2} to {hi:.2} \
              -> {}",
             found.len(),
             found.len() - lines,
             self.output.display()
-        );
-        Ok(())
+        ))
     }
 
     /// With `--frames`: the frame suggestions are made at, and the range.
