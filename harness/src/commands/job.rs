@@ -242,15 +242,7 @@ impl Job {
                     "sequences need --frames (e.g. --frames 1001-1048)",
                 ))
             }
-            None => Ok(vec![scene
-                .and_then(|s| {
-                    s.keyframes
-                        .first()
-                        .map(|k| k.frame)
-                        .or(s.progress.first().map(|p| p.0))
-                })
-                .or(lines.iter().find_map(|l| l.frame))
-                .unwrap_or(0.0) as i64]),
+            None => Ok(vec![first_frame(scene, lines)]),
         }
     }
 
@@ -396,9 +388,23 @@ impl Job {
     }
 }
 
+/// The frame a render of single plates is at: the first the scene keys
+/// (features or progress), else the first keyed line's, else 0.
+pub fn first_frame(scene: Option<&Scene>, lines: &[LineKey]) -> i64 {
+    scene
+        .and_then(|s| {
+            s.keyframes
+                .first()
+                .map(|k| k.frame)
+                .or(s.progress.first().map(|p| p.0))
+        })
+        .or(lines.iter().find_map(|l| l.frame))
+        .unwrap_or(0.0) as i64
+}
+
 /// Every `--param` set on `inst` as a host would, and none that `scene`
 /// would silently override.
-fn apply_params(
+pub fn apply_params(
     inst: &Instance<'_>,
     scene: Option<&Scene>,
     params: &[ParamSetting],

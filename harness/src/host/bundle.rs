@@ -132,6 +132,13 @@ fn object_holding(address: *const c_void) -> Option<PathBuf> {
     Some(PathBuf::from(name.to_string_lossy().into_owned()))
 }
 
+/// The executable or shared library this code is linked into: `morphfx`
+/// itself, or the Python module, which links the harness and the plugin
+/// and so is an OpenFX binary of its own.
+pub fn this_binary() -> Option<PathBuf> {
+    object_holding(this_binary as *const c_void)
+}
+
 /// A loaded bundle and its plugins.
 pub struct Bundle {
     pub binary: PathBuf,
@@ -420,3 +427,17 @@ unsafe impl Sync for PluginInfo {}
 unsafe impl Send for Bundle {}
 // SAFETY: as above.
 unsafe impl Sync for Bundle {}
+
+#[cfg(test)]
+mod tests {
+    /// Linked into a test executable, the code is that executable's.
+    #[test]
+    fn this_binary_is_the_one_the_code_is_linked_into() {
+        let found = super::this_binary().expect("the loader knows its executable");
+        let exe = std::env::current_exe().unwrap();
+        assert_eq!(
+            std::fs::canonicalize(found).unwrap(),
+            std::fs::canonicalize(exe).unwrap()
+        );
+    }
+}

@@ -10,11 +10,90 @@ use openfx::sys::image_effect_v1::image_effect::*;
 
 use super::props::PropertySet;
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub enum Pixels {
     U8(Vec<u8>),
     U16(Vec<u16>),
     F32(Vec<f32>),
+    /// Floats the frame does not own, lent by [`lend`] for one scope.
+    Lent(Lent),
+}
+
+/// Where lent floats lie. Only [`lend`] makes one, and it outlives none of
+/// the frames that hold it (no `Clone`: it cannot be copied out of one).
+#[derive(Debug, PartialEq)]
+pub struct Lent {
+    ptr: *const f32,
+    len: usize,
+}
+
+/// Rows of floats a caller lends to the host for one scope: a picture the
+/// host hands the plugin as a source without copying it.
+#[derive(Debug, Clone, Copy)]
+pub struct LentRows<'a> {
+    pub width: usize,
+    pub height: usize,
+    pub channels: usize,
+    /// Top row first.
+    pub data: &'a [f32],
+}
+
+/// Frames over `pictures` (float, top-down sources) for `body` to connect,
+/// render from and let go of: the host reads the caller's rows in place.
+/// Every frame must be gone when `body` returns (clips disconnected,
+/// images released); one that outlived it would point at rows the caller
+/// may free, so the process aborts then rather than go on unsound.
+pub fn lend<R>(
+    pictures: &[LentRows<'_>],
+    body: impl FnOnce(Vec<Arc<Frame>>) -> R,
+) -> Result<R, String> {
+    for (k, p) in pictures.iter().enumerate() {
+        let expected = p
+            .width
+            .checked_mul(p.height)
+            .and_then(|n| n.checked_mul(p.channels));
+        if expected != Some(p.data.len()) || p.width > i32::MAX as usize / 2 {
+            return Err(format!(
+                "picture {}: {} floats for {}x{}x{}",
+                k + 1,
+                p.data.len(),
+                p.height,
+                p.width,
+                p.channels
+            ));
+        }
+    }
+    let frames: Vec<Arc<Frame>> = pictures
+        .iter()
+        .map(|p| {
+            Arc::new(Frame {
+                bounds: RectI::new(0, 0, p.width as i32, p.height as i32),
+                channels: p.channels,
+                pixels: std::cell::UnsafeCell::new(Pixels::Lent(Lent {
+                    ptr: p.data.as_ptr(),
+                    len: p.data.len(),
+                })),
+                top_down: true,
+                premultiplied: true,
+                par: 1.0,
+            })
+        })
+        .collect();
+    /// Checks, even as a panic unwinds, that the scope's frames are gone.
+    struct Scope(Vec<Arc<Frame>>);
+    impl Drop for Scope {
+        fn drop(&mut self) {
+            let held = |f: &Arc<Frame>| Arc::strong_count(f) > 1 || Arc::weak_count(f) > 0;
+            if self.0.iter().any(held) {
+                eprintln!("morphfx host: a lent picture outlived its render; aborting");
+                std::process::abort();
+            }
+        }
+    }
+    let scope = Scope(frames.clone());
+    let out = body(frames);
+    drop(scope);
+    Ok(out)
 }
 
 #[derive(Debug)]
@@ -32,8 +111,20 @@ pub struct Frame {
 
 // SAFETY: plugins write to the output frame through raw pointers from render
 // threads, each to its own render window; the harness reads only after the
-// render returns. Nothing else mutates `pixels` while it is shared.
+// render returns. Nothing else mutates `pixels` while it is shared. Lent
+// rows are only read, and live as long as the frame (see `lend`).
 unsafe impl Sync for Frame {}
+// SAFETY: as for Sync: owned pixels are plain vectors, and lent rows are a
+// shared borrow that `lend` keeps alive for every thread the frame visits.
+unsafe impl Send for Frame {}
+
+impl Lent {
+    fn floats(&self) -> &[f32] {
+        // SAFETY: `lend` made this from a live `&[f32]` of `len` floats that
+        // outlives every frame holding it, and nothing writes through it.
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
 
 impl Frame {
     pub fn from_image(img: &Image, depth: &str, top_down: bool) -> Frame {
@@ -83,33 +174,42 @@ impl Frame {
     pub fn into_image(self: Arc<Self>) -> Image {
         match Arc::try_unwrap(self) {
             Ok(f) if !f.top_down => {
-                let Frame {
-                    bounds,
-                    channels,
-                    pixels,
-                    top_down,
-                    premultiplied,
-                    par,
-                } = f;
-                match pixels.into_inner() {
-                    Pixels::F32(data) => Image {
+                let (bounds, channels) = (f.bounds, f.channels);
+                match f.into_floats() {
+                    Ok(data) => Image {
                         bounds,
                         channels,
                         data,
                     },
-                    other => Frame {
-                        bounds,
-                        channels,
-                        pixels: std::cell::UnsafeCell::new(other),
-                        top_down,
-                        premultiplied,
-                        par,
-                    }
-                    .to_image(),
+                    Err(f) => f.to_image(),
                 }
             }
             Ok(f) => f.to_image(),
             Err(shared) => shared.to_image(),
+        }
+    }
+
+    /// The samples as they lie in memory, moved out, when they are floats;
+    /// the frame back otherwise.
+    pub fn into_floats(self) -> Result<Vec<f32>, Frame> {
+        let Frame {
+            bounds,
+            channels,
+            pixels,
+            top_down,
+            premultiplied,
+            par,
+        } = self;
+        match pixels.into_inner() {
+            Pixels::F32(data) => Ok(data),
+            other @ (Pixels::U8(_) | Pixels::U16(_) | Pixels::Lent(_)) => Err(Frame {
+                bounds,
+                channels,
+                pixels: std::cell::UnsafeCell::new(other),
+                top_down,
+                premultiplied,
+                par,
+            }),
         }
     }
 
@@ -137,7 +237,7 @@ impl Frame {
         match unsafe { &*self.pixels.get() } {
             Pixels::U8(_) => "OfxBitDepthByte",
             Pixels::U16(_) => "OfxBitDepthShort",
-            Pixels::F32(_) => "OfxBitDepthFloat",
+            Pixels::F32(_) | Pixels::Lent(_) => "OfxBitDepthFloat",
         }
     }
 
@@ -148,6 +248,7 @@ impl Frame {
             Pixels::U8(v) => v.iter().map(|&x| x as f32 / 255.0).collect(),
             Pixels::U16(v) => v.iter().map(|&x| x as f32 / 65535.0).collect(),
             Pixels::F32(v) => v.clone(),
+            Pixels::Lent(lent) => lent.floats().to_vec(),
         };
         let row = self.bounds.width() * self.channels;
         let data = if self.top_down {
@@ -228,6 +329,8 @@ impl Frame {
                 Pixels::U8(v) => (1, v.as_mut_ptr() as *mut c_void),
                 Pixels::U16(v) => (2, v.as_mut_ptr() as *mut c_void),
                 Pixels::F32(v) => (4, v.as_mut_ptr() as *mut c_void),
+                // Sources only: the plugin reads them (OFX gives sources to read).
+                Pixels::Lent(lent) => (4, lent.ptr as *mut c_void),
             }
         };
         let row_bytes = (row_elems * elem) as isize;
@@ -321,4 +424,53 @@ pub fn with_channels(img: &Image, channels: usize) -> Image {
             _ => 1.0,
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A lent frame reads the caller's rows in place: the host's image is
+    /// the caller's memory, top row last in canonical order.
+    #[test]
+    fn a_lent_picture_is_read_in_place() {
+        let rows: Vec<f32> = (0..2 * 3 * 4).map(|v| v as f32).collect();
+        let lent = LentRows {
+            width: 3,
+            height: 2,
+            channels: 4,
+            data: &rows,
+        };
+        let seen = lend(&[lent], |frames| {
+            let f = &frames[0];
+            let props = f.image_props((1.0, 1.0), 0.0);
+            let data = match props.get(&kOfxImagePropData.to_string_lossy()) {
+                Some(crate::host::props::Value::P(p)) => p[0],
+                other => panic!("no data pointer: {other:?}"),
+            };
+            // Top-down: the bottom row (canonical y = 0) is the caller's last.
+            (
+                data == rows[12..].as_ptr() as usize,
+                f.to_image().pixel(0, 1).to_vec(),
+            )
+        })
+        .unwrap();
+        assert!(seen.0, "the plugin is handed the caller's own bottom row");
+        assert_eq!(seen.1, vec![0.0, 1.0, 2.0, 3.0]);
+    }
+
+    /// Rows that do not hold the picture they claim are refused, before
+    /// any frame is made over them.
+    #[test]
+    fn rows_of_the_wrong_length_are_refused() {
+        let rows = vec![0.0f32; 10];
+        let lent = LentRows {
+            width: 3,
+            height: 2,
+            channels: 4,
+            data: &rows,
+        };
+        let err = lend(&[lent], |_| ()).unwrap_err();
+        assert!(err.contains("10 floats for 2x3x4"), "{err}");
+    }
 }

@@ -310,6 +310,25 @@ impl Instance<'_> {
         Ok(())
     }
 
+    /// Leaves `clip` unconnected, as a host does when its input is cut.
+    pub fn disconnect(&self, clip: &str) -> Result<(), HostError> {
+        let c = self
+            .effect
+            .clip(clip)
+            .ok_or_else(|| HostError::bad(format!("the plugin has no clip {clip}")))?;
+        *c.source.locked() = None;
+        c.props.set_int(kOfxImageClipPropConnected, &[0]);
+        Ok(())
+    }
+
+    /// Every param back to its default, unkeyed, as on a fresh instance:
+    /// how a host reuses an instance for an unrelated render.
+    pub fn reset_params(&self) {
+        for p in self.effect.params.params.locked().iter() {
+            p.reset();
+        }
+    }
+
     /// Anamorphic footage: pixels `par` canonical units wide, for the project
     /// and every clip (connect frames with the same `par`).
     pub fn set_pixel_aspect(&self, par: f64) {
@@ -783,3 +802,7 @@ impl Drop for Instance<'_> {
 // SAFETY: an instance's host state is behind its own locks, and the plugin
 // declares its renders fully thread safe.
 unsafe impl Sync for Instance<'_> {}
+// SAFETY: OFX lets a host call an instance's actions from any thread (Nuke
+// and Natron do); what the instance holds is its host state (behind its
+// locks) and pointers into the loaded bundle, which outlives it.
+unsafe impl Send for Instance<'_> {}

@@ -17,7 +17,7 @@ pub mod props;
 pub mod services;
 
 pub use crate::error::{ErrorKind, HostError, BAD_INPUT_ID};
-pub use bundle::{bundle_binary, Bundle, HostOptions, PluginInfo};
+pub use bundle::{bundle_binary, this_binary, Bundle, HostOptions, PluginInfo};
 #[cfg(test)]
 pub(crate) use checks::VIOLATION_TESTS;
 pub use checks::{host_failure, take_violations, violation};

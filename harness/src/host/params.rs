@@ -67,9 +67,15 @@ impl Param {
             p.kind = kind.to_owned();
             p.props.set_str(kOfxParamPropType, kind);
         }
-        let props = &p.props;
+        p.set(p.default_value());
+        p
+    }
+
+    /// The value its descriptor declares as default.
+    fn default_value(&self) -> ParamValue {
+        let props = &self.props;
         let mut v = ParamValue::default();
-        match p.shape() {
+        match self.shape() {
             Shape::Double(n) => {
                 for (k, d) in props
                     .doubles(kOfxParamPropDefault)
@@ -96,8 +102,12 @@ impl Param {
             }
             Shape::None => {}
         }
-        p.set(v);
-        p
+        v
+    }
+
+    /// Back to its default, unkeyed: as a fresh instance has it.
+    pub fn reset(&self) {
+        self.set(self.default_value());
     }
 
     fn state(&self) -> std::sync::MutexGuard<'_, (ParamValue, Vec<(f64, ParamValue)>)> {
