@@ -9,12 +9,13 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The crates checked, by the folder of their root file.
-const CRATES: [(&str, &str); 6] = [
+const CRATES: [(&str, &str); 7] = [
     (".", "src/lib.rs"),
     ("ofx-layer", "src/lib.rs"),
     ("ofx", "src/lib.rs"),
     ("harness", "src/lib.rs"),
     ("harness", "src/main.rs"),
+    ("python", "src/lib.rs"),
     ("xtask", "src/main.rs"),
 ];
 
