@@ -280,45 +280,8 @@ impl Shot {
 /// `openjd` in a virtual environment under `target/`, installed from PyPI
 /// with pinned versions the first time.
 fn runtime() -> Result<PathBuf, String> {
-    let venv = target_dir().join("openjd-venv");
-    let openjd = venv.join("bin").join("openjd");
-    let pinned = venv.join("pinned.txt");
-    if openjd.is_file() && std::fs::read_to_string(&pinned).is_ok_and(|p| p == OPENJD.join("\n")) {
-        return Ok(openjd);
-    }
-    if !tools::runs("python3", &["--version"]) {
-        return Err("no python3".into());
-    }
-    let _ = std::fs::remove_dir_all(&venv);
-    let made = Command::new("python3")
-        .args(["-m", "venv"])
-        .arg(&venv)
-        .output()
-        .map_err(|e| format!("python3 -m venv: {e}"))?;
-    if !made.status.success() {
-        return Err(format!(
-            "python3 -m venv failed: {}",
-            String::from_utf8_lossy(&made.stderr).trim()
-        ));
-    }
-    println!(
-        "installing {} into {} (pip)...",
-        OPENJD.join(" "),
-        venv.display()
-    );
-    let pip = Command::new(venv.join("bin").join("pip"))
-        .args(["install", "--quiet", "--disable-pip-version-check"])
-        .args(OPENJD)
-        .output()
-        .map_err(|e| format!("pip: {e}"))?;
-    if !pip.status.success() {
-        return Err(format!(
-            "pip could not install the runtime (PyPI unreachable?): {}",
-            String::from_utf8_lossy(&pip.stderr).trim()
-        ));
-    }
-    std::fs::write(&pinned, OPENJD.join("\n")).expect("write pinned.txt");
-    Ok(openjd)
+    let bin = tools::venv(&target_dir().join("openjd-venv"), &OPENJD)?;
+    Ok(bin.join("openjd"))
 }
 
 fn run(openjd: &Path, args: &[&std::ffi::OsStr]) -> Output {

@@ -1,6 +1,8 @@
 //! Developer tasks: `cargo xtask bundle [--release]`, `cargo xtask demo [-o DIR]`,
 //! `cargo xtask test`, `cargo xtask refhost` (the reference host check alone),
-//! `cargo xtask farm` (the Open Job Description check alone).
+//! `cargo xtask farm` (the Open Job Description check alone), `cargo xtask
+//! python` (the Python module's check alone), `cargo xtask wheel` (the
+//! Python module's wheel).
 //! Builds the plugin bundle first so the harness finds it.
 
 use std::path::{Path, PathBuf};
@@ -8,6 +10,7 @@ use std::process::{exit, Command};
 use std::time::Instant;
 
 mod farm;
+mod python;
 mod refhost;
 mod tools;
 mod workspace;
@@ -33,6 +36,12 @@ fn morphfx(release: bool, bundle: &Path) -> Command {
     c.arg("--").arg("--bundle").arg(bundle);
     c
 }
+
+/// The Python module's crate: built by maturin (`pip install ./python`),
+/// which links it as an extension module; a plain cargo build of the
+/// workspace leaves it out (it would link libpython), and the Python check
+/// builds and tests it.
+const PYTHON: &str = "morphfx-python";
 
 fn cargo(args: &[&str]) {
     let mut c = cargo_command();
@@ -189,11 +198,18 @@ fn main() {
                 exit(status.code().unwrap_or(1));
             }
         }
+        Some("python") => {
+            let morphfx = morphfx_binary();
+            python::check(&morphfx, &bundle(false));
+        }
+        Some("wheel") => {
+            println!("wheel: {}", python::wheel().display());
+        }
         Some("test") => test(&args[1..]),
         _ => {
             eprintln!(
                 "usage: cargo xtask bundle [--release] | demo [-o DIR] | test \
-                    [cargo test args] | refhost | farm"
+                    [cargo test args] | refhost | farm | python | wheel"
             );
             exit(2);
         }
@@ -208,7 +224,7 @@ fn test(cargo_args: &[String]) {
     // Tests find the bundle through this variable.
     unsafe_env("MORPHFX_BUNDLE", &b);
     let mut skipped = timed("tools", ensure_tools);
-    let mut run = vec!["test", "--workspace"];
+    let mut run = vec!["test", "--workspace", "--exclude", PYTHON];
     run.extend(cargo_args.iter().map(String::as_str));
     timed("cargo test", || cargo(&run));
     timed("core tests as x86-64-v3 code", core_tests_fast);
@@ -217,6 +233,7 @@ fn test(cargo_args: &[String]) {
     skipped.extend(timed("reference host", || refhost::check(&b)));
     let morphfx = dev_morphfx();
     skipped.extend(timed("farm", || farm::check(&morphfx, &b)));
+    skipped.extend(timed("python module", || python::check(&morphfx, &b)));
     timed("cmake install", || cmake_install_check(&morphfx));
     timed("cargo install", || morphfx_install_check(&b));
     summary(&skipped);
@@ -315,7 +332,15 @@ fn skips_fail(skipped: &[String], ci: bool, can_apt: bool) -> bool {
 /// baseline dev, baseline release for CMake), not four.
 fn build_for_tests() -> PathBuf {
     let fast = cfg!(target_arch = "x86_64").then(|| build_plugin(true, true));
-    cargo(&["build", "--workspace", "--lib", "--bins", "--tests"]);
+    cargo(&[
+        "build",
+        "--workspace",
+        "--exclude",
+        PYTHON,
+        "--lib",
+        "--bins",
+        "--tests",
+    ]);
     let baseline = plugin_binary(&target_dir(), "debug");
     lay_out("bundle", &baseline, fast.as_deref())
 }
@@ -357,7 +382,14 @@ fn release_concurrency(dev_bundle: &Path) {
     let b = lay_out("bundle-release", &plugin, None);
     unsafe_env("MORPHFX_BUNDLE", &b);
     // `--workspace`, as the test build: the same features, nothing rebuilt.
-    cargo(&["test", "--workspace", "--test", "concurrency"]);
+    cargo(&[
+        "test",
+        "--workspace",
+        "--exclude",
+        PYTHON,
+        "--test",
+        "concurrency",
+    ]);
     unsafe_env("MORPHFX_BUNDLE", dev_bundle);
 }
 
@@ -384,7 +416,13 @@ fn docs() {
     let flags = std::env::var("RUSTDOCFLAGS").unwrap_or_default();
     let parts: [&[&str]; 2] = [
         &["--package", "morphfx-harness"],
-        &["--workspace", "--exclude", "morphfx-harness"],
+        &[
+            "--workspace",
+            "--exclude",
+            "morphfx-harness",
+            "--exclude",
+            PYTHON,
+        ],
     ];
     for part in parts {
         let mut c = cargo_command();
