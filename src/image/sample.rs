@@ -18,14 +18,18 @@ pub enum Filter {
     /// 4×4 taps, Catmull-Rom (Keys cubic, a = −0.5). Interpolating like
     /// bilinear, sharper; may overshoot at edges (never clamped: HDR data).
     Bicubic,
+    /// The one pixel the position falls in, unblended: for IDs and mattes,
+    /// whose values must stay values the source holds.
+    Nearest,
 }
 
 impl Choice for Filter {
-    const ALL: &'static [Self] = &[Filter::Bilinear, Filter::Bicubic];
+    const ALL: &'static [Self] = &[Filter::Bilinear, Filter::Bicubic, Filter::Nearest];
     fn name(self) -> &'static str {
         match self {
             Filter::Bilinear => "bilinear",
             Filter::Bicubic => "bicubic",
+            Filter::Nearest => "nearest",
         }
     }
 }
@@ -140,7 +144,7 @@ impl<'a, T: Sample> Sampler<'a, T> {
     /// RGBA of any sample type ([`direct_rgba`]); `None` for any other
     /// layout, which takes the general path.
     pub(crate) fn direct_taps(&self) -> Option<Taps<'a, T>> {
-        if self.view.channels() != 4 || self.alpha_weighted {
+        if self.view.channels() != 4 || self.alpha_weighted || self.filter == Filter::Nearest {
             return None;
         }
         let cubic = self.filter == Filter::Bicubic;
@@ -222,6 +226,13 @@ impl<'a, T: Sample> Sampler<'a, T> {
                 ];
                 self.accumulate(&taps, out);
             }
+            Filter::Nearest => {
+                // The pixel whose square holds the position: [i, i + 1) in x.
+                let (i, j) = ((fx + 0.5).floor() as i32, (fy + 0.5).floor() as i32);
+                if !self.pixel(i, j, out) {
+                    self.accumulate(&[(i, j, 1.0)], out);
+                }
+            }
             Filter::Bicubic => {
                 let wx = catmull_rom_weights(tx);
                 let wy = catmull_rom_weights(ty);
@@ -242,6 +253,12 @@ impl<'a, T: Sample> Sampler<'a, T> {
     /// inside the image, off centre lines) runs eight positions at a time
     /// without edge handling, specialised per layout and filter.
     pub fn sample_row(&self, positions: &[[f32; 2]], out: &mut [[f32; 4]]) {
+        if self.filter == Filter::Nearest {
+            for (&[x, y], o) in positions.iter().zip(out) {
+                self.sample(x, y, o);
+            }
+            return;
+        }
         let cubic = self.filter == Filter::Bicubic;
         match (self.view.channels(), self.alpha_weighted, cubic) {
             (4, true, false) => self.row::<4, true, false>(positions, out),
@@ -522,7 +539,7 @@ mod tests {
                 let layout = Layout::packed(bounds, channels);
                 let data: Vec<T> = (0..bounds.area() * channels).map(&value).collect();
                 let view = ImageView::new(&data, layout).unwrap();
-                for filter in [Filter::Bilinear, Filter::Bicubic] {
+                for &filter in Filter::ALL {
                     for edge in [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror] {
                         for premultiplied in [true, false] {
                             let s = Sampler::new(
@@ -553,5 +570,40 @@ mod tests {
         check::<f32>(bounds, &positions, |i| ((i * 7919) % 1013) as f32 / 1013.0);
         check::<u8>(bounds, &positions, |i| ((i * 7919) % 251) as u8);
         check::<u16>(bounds, &positions, |i| ((i * 7919) % 65521) as u16);
+    }
+
+    /// Nearest sampling returns the value of the pixel whose square holds
+    /// the position (x in [i, i + 1) is pixel i at scale 1, [i/2, (i+1)/2)
+    /// at scale 2), and so only values the source holds: IDs stay IDs.
+    #[test]
+    fn nearest_reads_the_pixel_the_position_falls_in() {
+        use crate::image::{ImageView, Layout};
+        let bounds = RectI::new(0, 0, 4, 3);
+        let ids: Vec<f32> = (0..12).map(|k| (k * 10 + 7) as f32).collect();
+        let view = ImageView::new(&ids, Layout::packed(bounds, 1)).unwrap();
+        let at = |scale: f64, edge: EdgeMode, x: f32, y: f32| {
+            let s = Sampler::new(
+                view,
+                PixelScale::new(scale, scale, 1.0),
+                Filter::Nearest,
+                edge,
+                true,
+            );
+            let mut out = [0f32; 4];
+            s.sample(x, y, &mut out);
+            out[0]
+        };
+        let id = |i: usize, j: usize| (10 * (j * 4 + i) + 7) as f32;
+        assert_eq!(at(1.0, EdgeMode::Clamp, 2.0, 1.0), id(2, 1));
+        assert_eq!(at(1.0, EdgeMode::Clamp, 2.999, 1.5), id(2, 1));
+        assert_eq!(at(1.0, EdgeMode::Clamp, 1.7, 0.2), id(1, 0));
+        assert_eq!(at(2.0, EdgeMode::Clamp, 1.2, 0.6), id(2, 1));
+        assert_eq!(at(1.0, EdgeMode::Clamp, 9.0, 1.5), id(3, 1));
+        assert_eq!(at(1.0, EdgeMode::Black, 9.0, 1.5), 0.0);
+        for k in 0..200 {
+            let (x, y) = (k as f32 * 0.0213, (k * 7 % 31) as f32 * 0.097);
+            let v = at(1.0, EdgeMode::Mirror, x, y);
+            assert!(ids.contains(&v), "{v} at ({x}, {y}) is no source value");
+        }
     }
 }
