@@ -662,7 +662,8 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
     t.extend([
         FILTER.spec(
             "Filter",
-            "bilinear, or bicubic (Catmull-Rom: sharper, may overshoot).",
+            "bilinear, bicubic (Catmull-Rom: sharper, may overshoot), or nearest (the \
+            source pixel itself, unblended: for IDs and mattes).",
             Filter::Bilinear,
         ),
         EDGE.spec(

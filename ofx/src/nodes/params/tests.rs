@@ -68,7 +68,7 @@ const RELEASED_BOTH: &[(&str, &[&str])] = &[
         "transition_affects",
         &["geometry and colour", "geometry", "colour"],
     ),
-    ("filter", &["bilinear", "bicubic"]),
+    ("filter", &["bilinear", "bicubic", "nearest"]),
     ("edge", &["clamp", "black", "mirror"]),
     (
         "overlay_show",

@@ -440,7 +440,10 @@ fn prepare<'r>(
     if mesh {
         inputs.warp.mesh_pair()?; // a missing mesh is bad input before any pixel
     }
-    let two_pass = mesh && inputs.warp.settings.mesh.pass == Pass::TwoPass;
+    // Fant's filter averages: nearest sampling (IDs) takes the one-pass map.
+    let two_pass = mesh
+        && inputs.warp.settings.mesh.pass == Pass::TwoPass
+        && request.settings.filter != Filter::Nearest;
     let picture = view.is_picture();
     // A non-uniform colour transition weighs every pixel of the dissolve.
     let weighted = matches!(view, View::Morph | View::Folds)
