@@ -133,6 +133,16 @@ pub enum Command {
         /// where its alpha is, the input elsewhere (with the `mix` param).
         #[arg(long)]
         mask: Option<String>,
+        /// The layers of a multi-layer EXR input to warp, all through the
+        /// same warp into one EXR: rgba (the main picture alone), all, or
+        /// a list (rgba,N,id).
+        #[arg(long, default_value = "rgba")]
+        layers: String,
+        /// Layers sampled nearest (never blended) besides those whose
+        /// names say they hold IDs or mattes (id, crypto*, *mask*,
+        /// *matte*): a list.
+        #[arg(long = "id-layers", default_value = "")]
+        id_layers: String,
     },
     /// List every param of the nodes: id, type, default and range.
     Params {

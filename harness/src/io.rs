@@ -332,7 +332,7 @@ fn is_alpha(name: &exr::meta::attribute::Text) -> bool {
 
 /// An EXR data window in canonical pixels: EXR y grows downwards, canonical y
 /// upwards from the display window's bottom.
-fn data_bounds(
+pub(crate) fn data_bounds(
     display: exr::meta::attribute::IntegerBounds,
     pos: exr::math::Vec2<i32>,
     (w, h): (usize, usize),
@@ -349,7 +349,7 @@ fn data_bounds(
 
 /// What went wrong reading an EXR, in words a user can act on (the exr
 /// crate's own say "reference to missing bytes" for a cut-short file).
-fn exr_read_error(path: &Path, e: exr::error::Error) -> HostError {
+pub(crate) fn exr_read_error(path: &Path, e: exr::error::Error) -> HostError {
     use exr::error::Error;
     use std::io::ErrorKind;
     let truncated = match &e {
@@ -536,10 +536,6 @@ pub fn write_as(
     plate: &Plate,
     format: OutputFormat,
 ) -> std::result::Result<(), HostError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -554,15 +550,28 @@ pub fn write_as(
             path.display()
         )));
     }
+    write_atomically(path, |tmp| match ext.as_str() {
+        "exr" => write_exr(tmp, plate, format),
+        _ => write_other(tmp, plate, &ext, format.colour),
+    })
+}
+
+/// Runs `write` on a temporary file in `path`'s folder (made if need be),
+/// then renames it over `path`: a reader never sees half a file, and a
+/// failed write leaves whatever stood there before.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> std::result::Result<(), HostError>,
+) -> std::result::Result<(), HostError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)
         .map_err(|e| HostError::bad(format!("{}: cannot create folder: {e}", dir.display())))?;
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
     let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
-    let result = match ext.as_str() {
-        "exr" => write_exr(&tmp, plate, format),
-        _ => write_other(&tmp, plate, &ext, format.colour),
-    };
-    let result = result.and_then(|_| {
+    let result = write(&tmp).and_then(|_| {
         std::fs::rename(&tmp, path)
             .map_err(|e| HostError::failed(format!("cannot rename it into place: {e}")))
     });

@@ -9,6 +9,7 @@ pub mod exr_zip;
 pub mod host;
 pub mod interrupt;
 pub mod io;
+pub mod layered;
 pub mod locate;
 pub mod one_frame;
 pub mod pipeline;

@@ -182,7 +182,11 @@ fn render_job(command: Command) -> Result<job::Job, HostError> {
             stmap,
             view,
             mask,
-        } => Ok(job::warp_job(common, input, stmap, view).with_mattes(mask, None)),
+            layers,
+            id_layers,
+        } => job::warp_job(common, input, stmap, view)
+            .with_mattes(mask, None)
+            .with_layers(&layers, &id_layers),
         _ => Err(HostError::bad(
             "morphfx job openjd: a farm job runs morph or warp",
         )),

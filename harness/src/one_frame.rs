@@ -18,7 +18,8 @@ use crate::args::param_value::ParamSetting;
 use crate::commands::job::{apply_params, first_frame, MORPH_ID, WARP_ID};
 use crate::host::frame::lend;
 pub use crate::host::frame::LentRows;
-use crate::host::{Bundle, Frame, FrameSource, HostError, Instance, OutputSpec};
+use crate::host::{Bundle, Frame, HostError, Instance, OutputSpec};
+use crate::plates::Still;
 pub use crate::rows::Rows;
 
 /// Which node renders, in the context the command line uses for it.
@@ -101,15 +102,6 @@ fn size_of(sources: &[LentRows<'_>]) -> Result<(usize, usize), HostError> {
         }
     }
     Ok(size)
-}
-
-/// A picture that is the same at every frame (a single plate).
-struct Still(Arc<Frame>);
-
-impl FrameSource for Still {
-    fn frame(&self, _time: f64) -> Result<Arc<Frame>, String> {
-        Ok(self.0.clone())
-    }
 }
 
 /// What a render failed at: the request's scene, its params (an

@@ -120,3 +120,13 @@ impl FrameSource for Plates {
             .map_err(|e| e.message)
     }
 }
+
+/// A picture that is the same at every frame: a single plate, or a
+/// picture held in memory.
+pub struct Still(pub Arc<Frame>);
+
+impl FrameSource for Still {
+    fn frame(&self, _time: f64) -> Result<Arc<Frame>, String> {
+        Ok(self.0.clone())
+    }
+}

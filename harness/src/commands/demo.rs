@@ -63,6 +63,7 @@ pub fn demo(bundle_path: &Path, dir: &Path) -> Result<(), HostError> {
                     compression: None,
                     raw: false,
                 },
+                layers: None,
             }
             .run(bundle_path)
         };

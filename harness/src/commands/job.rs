@@ -10,6 +10,7 @@ use morphfx::scene::Scene;
 use crate::args::line_key::LineKey;
 use crate::args::param_value::ParamSetting;
 use crate::cli::Common;
+use crate::commands::layers::{self, LayerChoice, LayeredRun};
 use crate::host::{Bundle, HostError, Instance, OutputSpec};
 use crate::interrupt;
 use crate::io::{self, ExrPrecision, Plate};
@@ -34,6 +35,7 @@ pub fn warp_job(common: Common, input: String, stmap: Option<String>, view: Stri
             .unwrap_or_default(),
         mattes: Vec::new(),
         common,
+        layers: None,
     }
 }
 
@@ -69,6 +71,7 @@ pub fn morph_job(
             .collect(),
         mattes: Vec::new(),
         common,
+        layers: None,
     })
 }
 
@@ -115,6 +118,9 @@ pub struct Job {
     /// Optional matte clips and their plates: (clip, path pattern).
     pub mattes: Vec<(String, String)>,
     pub common: Common,
+    /// `warp --layers`: the layers of a multi-layer EXR to warp (`None`:
+    /// the main picture, as any render).
+    pub layers: Option<LayerChoice>,
 }
 
 impl Job {
@@ -125,6 +131,17 @@ impl Job {
             .filter_map(|(clip, p)| p.map(|p| (clip.to_owned(), p)))
             .collect();
         self
+    }
+
+    /// The job warping `--layers SPEC` (with `--id-layers IDS`) of its
+    /// input, checked against the rest of the command line.
+    pub fn with_layers(mut self, spec: &str, ids: &str) -> Result<Job, HostError> {
+        self.layers = LayerChoice::parse(spec, ids)?;
+        if self.layers.is_some() {
+            let (_, input) = &self.sources[0];
+            layers::check(input, &self.common.output, &self.view, self.extra.len())?;
+        }
+        Ok(self)
     }
 
     /// Everything a run reads before it loads the bundle: the scene, the
@@ -228,7 +245,28 @@ impl Job {
         let bundle = Bundle::load(bundle_path)?;
         let inst = bundle.instance(self.plugin, self.context)?;
         self.set_up(&inst, &job)?;
-        self.render_frames(&inst, &job)
+        match &self.layers {
+            Some(choice) => self.render_layers(&inst, &job, choice),
+            None => self.render_frames(&inst, &job),
+        }
+    }
+
+    /// `--layers`: every chosen layer through the same warp, frame by frame.
+    fn render_layers(
+        &self,
+        inst: &Instance<'_>,
+        job: &Prepared,
+        choice: &LayerChoice,
+    ) -> Result<(), HostError> {
+        inst.set_choice("view", &self.view)?;
+        let run = LayeredRun {
+            input: &self.sources[0].1,
+            output: &self.common.output,
+            frames: &job.frames,
+            format: self.common.output_format(&job.inputs)?,
+            purge: job.animated(self.common.t.is_some()),
+        };
+        run.render(inst, choice)
     }
 
     /// The frames to render: `--frames`, else the one frame the scene or

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod demo;
 pub mod job;
+pub mod layers;
 pub mod openjd;
 pub mod overlay;
 pub mod params;

@@ -30,6 +30,7 @@ pub fn overlay_job(
             extra: Vec::new(),
             mattes: Vec::new(),
             common,
+            layers: None,
         }),
         _ => Err(HostError::bad(
             "overlay needs --a and --b (Morph) or --input (Warp)",

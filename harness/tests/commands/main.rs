@@ -10,6 +10,7 @@ mod corrupt_exr;
 mod doc_examples;
 mod farm;
 mod faults;
+mod layers_cli;
 mod long_run;
 mod mattes_cli;
 mod methods;

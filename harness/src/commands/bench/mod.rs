@@ -120,6 +120,7 @@ pub fn bench(
             compression: None,
             raw: false,
         },
+        layers: None,
     }
     .run(bundle_path)?;
     let took = started.elapsed().as_secs_f64();
