@@ -177,18 +177,20 @@ impl OneFrame<'_> {
             .filter_map(|(clip, rows)| Some((*clip, rows?)))
             .unzip();
         let rendered = |frames: Vec<Arc<Frame>>| {
-            for (clip, frame) in clips.iter().zip(frames) {
-                inst.connect(clip, Arc::new(Still(frame)))?;
-            }
+            let connected = clips
+                .iter()
+                .zip(frames)
+                .try_for_each(|(clip, frame)| inst.connect(clip, Arc::new(Still(frame))));
             let spec = OutputSpec {
                 sequential: true,
                 top_down: true,
                 ..OutputSpec::default()
             };
-            let rendered = render_connected(inst, frame, spec, size);
-            // The inputs let go: the lent rows are the caller's again.
+            let rendered = connected.and_then(|()| render_connected(inst, frame, spec, size));
+            // The inputs let go, whatever happened: the lent rows are the
+            // caller's again (a clip this node has always disconnects).
             for clip in &clips {
-                inst.disconnect(clip)?;
+                let _ = inst.disconnect(clip);
             }
             rendered
         };

@@ -190,3 +190,15 @@ def test_a_render_keeps_nothing_of_the_one_before(files):
                   params={"filter": "bicubic", "mix": {0: 0.2, 9: 0.9}, "edge": "black"})
     morphfx.warp(scene, a, t=0.1, params={"mix": 0.3}, mask=mask)
     assert np.array_equal(morphfx.morph(scene, a, b, t=0.4), first)
+
+
+def test_a_failed_render_raises_and_the_next_one_renders(files):
+    """The plugin fails this render after it has fetched the pictures: the
+    error is raised, the pictures are let go, and rendering goes on."""
+    far = json.loads((files / "thin-plate.morph.json").read_text())
+    far["features"][0]["a"] = [[500.0, 20.0]]
+    scene = morphfx.Scene.from_json(json.dumps(far))
+    with pytest.raises(morphfx.RenderError, match="outside the frame"):
+        morphfx.morph(scene, plate(0), plate(2), t=0.5)
+    good = morphfx.Scene.load(files / "thin-plate.morph.json")
+    assert morphfx.morph(good, plate(0), plate(2), t=0.5).shape == (H, W, 4)
