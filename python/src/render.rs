@@ -156,6 +156,38 @@ fn run<'py>(py: Python<'py>, req: OneFrame) -> PyResult<Bound<'py, PyArray3<f32>
     array_of(py, rendered(py, req)?)
 }
 
+/// What every render call is asked besides its pictures.
+struct Asked<'a, 'py> {
+    scene: Option<&'a Bound<'py, PyAny>>,
+    t: Option<f64>,
+    frame: Option<f64>,
+    view: &'a str,
+    params: Option<&'a Bound<'py, PyDict>>,
+}
+
+impl Asked<'_, '_> {
+    /// The request of `node` on these pictures.
+    fn request<'r>(
+        &self,
+        node: Node,
+        sources: Vec<LentRows<'r>>,
+        mask: Option<LentRows<'r>>,
+        timing: Option<LentRows<'r>>,
+    ) -> PyResult<OneFrame<'r>> {
+        Ok(OneFrame {
+            node,
+            sources,
+            mask,
+            timing,
+            scene: scene_text(self.scene)?,
+            t: self.t,
+            frame: self.frame,
+            view: self.view.to_owned(),
+            params: param_settings(self.params)?,
+        })
+    }
+}
+
 /// Sources carry colour: RGB or RGBA.
 const SOURCE: &[usize] = &[3, 4];
 /// Mattes are read by their alpha, or an RGB matte by its mean.
@@ -191,18 +223,18 @@ pub fn morph<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let (a, b) = (borrowed(a, "a", SOURCE)?, borrowed(b, "b", SOURCE)?);
     let (mask, timing) = (matte(mask, "mask")?, matte(timing, "timing")?);
-    let req = OneFrame {
-        node: Node::Morph,
-        sources: vec![a.rows()?, b.rows()?],
-        mask: lent(&mask)?,
-        timing: lent(&timing)?,
-        scene: scene_text(scene)?,
+    let asked = Asked {
+        scene,
         t,
         frame,
-        view: view.to_owned(),
-        params: param_settings(params)?,
+        view,
+        params,
     };
-    run(py, req)
+    let sources = vec![a.rows()?, b.rows()?];
+    run(
+        py,
+        asked.request(Node::Morph, sources, lent(&mask)?, lent(&timing)?)?,
+    )
 }
 
 /// A warped toward the features' positions at t (the Warp node), float32
@@ -222,18 +254,17 @@ pub fn warp<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let view = if view == "morph" { "warped" } else { view };
     let (a, mask) = (borrowed(a, "a", SOURCE)?, matte(mask, "mask")?);
-    let req = OneFrame {
-        node: Node::Warp,
-        sources: vec![a.rows()?],
-        mask: lent(&mask)?,
-        timing: None,
-        scene: scene_text(scene)?,
+    let asked = Asked {
+        scene,
         t,
         frame,
-        view: view.to_owned(),
-        params: param_settings(params)?,
+        view,
+        params,
     };
-    run(py, req)
+    run(
+        py,
+        asked.request(Node::Warp, vec![a.rows()?], lent(&mask)?, None)?,
+    )
 }
 
 /// The ST map side `"a"` or `"b"` is warped with at t, float32 `(H, W, 2)`
@@ -274,20 +305,18 @@ pub fn stmap<'py>(
         picture.map(|p| borrowed(p, what, SOURCE)).transpose()
     };
     let (a, b) = (given(a, "a")?, given(b, "b")?);
-    let req = OneFrame {
-        node: Node::Morph,
-        sources: vec![
-            map_source(&a, &blank, (width, height), "a")?,
-            map_source(&b, &blank, (width, height), "b")?,
-        ],
-        mask: None,
-        timing: None,
-        scene: scene_text(scene)?,
+    let asked = Asked {
+        scene,
         t: Some(t),
         frame,
-        view: view.to_owned(),
-        params: param_settings(params)?,
+        view,
+        params,
     };
+    let sources = vec![
+        map_source(&a, &blank, (width, height), "a")?,
+        map_source(&b, &blank, (width, height), "b")?,
+    ];
+    let req = asked.request(Node::Morph, sources, None, None)?;
     let map = rendered(py, req)?;
     let data = map
         .data

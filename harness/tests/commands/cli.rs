@@ -4,19 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use crate::common;
+use crate::common::morphfx_said as morphfx;
 use std::process::Command;
 
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx_harness::io::{self, ExrPrecision, Plate};
-
-fn morphfx(args: &[&str]) -> (i32, String) {
-    let out = common::run_morphfx(args);
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn tmp(name: &str) -> common::Scratch {
     common::scratch(name)

@@ -8,6 +8,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use crate::common;
+use crate::common::{morphfx_ok as ok, morphfx_said as morphfx};
 
 use exr::prelude::*;
 
@@ -18,19 +19,6 @@ const LINE: &str = "1=10,10,60,14,18,6,66,22";
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-fn morphfx(args: &[&str]) -> (i32, String) {
-    let out = common::run_morphfx(args);
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn ok(args: &[&str]) {
-    let (code, err) = morphfx(args);
-    assert_eq!(code, 0, "morphfx {args:?}: {err}");
 }
 
 /// A channel's value at pixel (x, row from the top).
@@ -50,21 +38,26 @@ fn value(name: &str, x: usize, y: usize) -> f32 {
     }
 }
 
-/// A single-part float EXR holding `channels` (full names), written by the
-/// exr crate.
-fn write_exr(path: &Path, channels: &[(&str, &str)]) {
-    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+/// Float channels named `(name, value it holds)`, for the exr crate.
+fn channels(list: &[(&str, &str)]) -> AnyChannels<FlatSamples> {
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = list
         .iter()
         .map(|(name, from)| {
             let samples = (0..W * H).map(|k| value(from, k % W, k / W)).collect();
             AnyChannel::new(*name, FlatSamples::F32(samples))
         })
         .collect();
+    AnyChannels::sort(list)
+}
+
+/// A single-part float EXR holding `list` (full names), written by the
+/// exr crate.
+fn write_exr(path: &Path, list: &[(&str, &str)]) {
     let layer = Layer::new(
         Vec2(W, H),
         LayerAttributes::default(),
         Encoding::SMALL_LOSSLESS,
-        AnyChannels::sort(list),
+        channels(list),
     );
     Image::from_layer(layer).write().to_file(path).unwrap();
 }
@@ -267,19 +260,12 @@ fn layers_refuse_what_they_cannot_do_with_exit_2() {
 fn the_parts_of_a_multi_part_file_name_their_layers() {
     let d = common::scratch("layers-parts");
     let d = Path::new(&d);
-    let part = |name: &str, channels: &[(&str, &str)]| {
-        let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
-            .iter()
-            .map(|(own, from)| {
-                let samples = (0..W * H).map(|k| value(from, k % W, k / W)).collect();
-                AnyChannel::new(*own, FlatSamples::F32(samples))
-            })
-            .collect();
+    let part = |name: &str, list: &[(&str, &str)]| {
         Layer::new(
             Vec2(W, H),
             LayerAttributes::named(name),
             Encoding::SMALL_LOSSLESS,
-            AnyChannels::sort(list),
+            channels(list),
         )
     };
     let parts: Layers<_> = [

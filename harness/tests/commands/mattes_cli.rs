@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::common;
+use crate::common::{morphfx_ok as ok, morphfx_said as morphfx};
 
 use morphfx::geom::RectI;
 use morphfx::image::Image;
@@ -18,19 +19,6 @@ const STILL_LINE: &str = "1=10,10,60,10,10,10,60,10";
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-fn morphfx(args: &[&str]) -> (i32, String) {
-    let out = common::run_morphfx(args);
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn ok(args: &[&str]) {
-    let (code, err) = morphfx(args);
-    assert_eq!(code, 0, "morphfx {args:?}: {err}");
 }
 
 /// An opaque textured plate in `[0.1, 0.9]`, written as a float EXR.

@@ -129,6 +129,24 @@ pub fn run_morphfx(args: &[&str]) -> Output {
         .expect("morphfx runs")
 }
 
+/// `morphfx ARGS...` as [`run_morphfx`]: its exit status and what it said
+/// on standard error.
+#[allow(dead_code)] // not every test file runs the binary
+pub fn morphfx_said(args: &[&str]) -> (i32, String) {
+    let out = run_morphfx(args);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// `morphfx ARGS...`, which must succeed.
+#[allow(dead_code)] // not every test file runs the binary
+pub fn morphfx_ok(args: &[&str]) {
+    let (code, err) = morphfx_said(args);
+    assert_eq!(code, 0, "morphfx {args:?}: {err}");
+}
+
 /// An opaque `w × h` float EXR at `path` whose pixel centres take `colour`
 /// (canonical position in, RGB out); returns the image written.
 #[allow(dead_code)] // not every test file writes generated plates
