@@ -18,6 +18,8 @@ use crate::scene::Scene;
 
 /// This module as an OpenFX binary, loaded once: the module's own shared
 /// object exports the plugin's entry points, since it links the plugin.
+/// Loaded with the GIL released (the plugin's load runs then), so a second
+/// thread that comes meanwhile waits here without holding the GIL.
 fn bundle(py: Python<'_>) -> PyResult<&'static Bundle> {
     static BUNDLE: OnceLock<Bundle> = OnceLock::new();
     static LOADING: Mutex<()> = Mutex::new(());
@@ -26,12 +28,15 @@ fn bundle(py: Python<'_>) -> PyResult<&'static Bundle> {
     }
     let file = this_binary()
         .ok_or_else(|| RenderError::new_err("cannot find the morphfx module's own file"))?;
-    let _one_at_a_time = LOADING.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(b) = BUNDLE.get() {
-        return Ok(b);
-    }
-    let loaded = py.detach(|| Bundle::load(&file)).map_err(errors::render)?;
-    Ok(BUNDLE.get_or_init(|| loaded))
+    py.detach(|| {
+        let _one_at_a_time = LOADING.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(b) = BUNDLE.get() {
+            return Ok(b);
+        }
+        let loaded = Bundle::load(&file)?;
+        Ok(BUNDLE.get_or_init(|| loaded))
+    })
+    .map_err(errors::render)
 }
 
 /// A scene argument: a `Scene`, a path to a scene file, or `None`.

@@ -202,3 +202,26 @@ def test_a_failed_render_raises_and_the_next_one_renders(files):
         morphfx.morph(scene, plate(0), plate(2), t=0.5)
     good = morphfx.Scene.load(files / "thin-plate.morph.json")
     assert morphfx.morph(good, plate(0), plate(2), t=0.5).shape == (H, W, 4)
+
+
+def test_threads_that_render_first_all_at_once_finish(tmp_path):
+    """The module loads its plugin on first use: threads that all start
+    there at once must each get it, none waiting on another for ever."""
+    import subprocess
+    import sys
+    script = tmp_path / "first.py"
+    script.write_text(
+        "import threading, numpy as np, morphfx, json\n"
+        f"scene = morphfx.Scene.from_json({json.dumps(json.dumps(scene_doc('field')))})\n"
+        "a = np.zeros((64, 96, 4), np.float32)\n"
+        "out = []\n"
+        "def go():\n"
+        "    out.append(morphfx.morph(scene, a, a, t=0.5).shape)\n"
+        "ts = [threading.Thread(target=go) for _ in range(16)]\n"
+        "[t.start() for t in ts]\n"
+        "[t.join() for t in ts]\n"
+        "print(len(out))\n")
+    for _ in range(5):  # a race: several fresh processes give it its chances
+        done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                              timeout=60)
+        assert done.returncode == 0 and done.stdout.strip() == "16", done.stderr
