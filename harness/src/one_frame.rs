@@ -195,7 +195,11 @@ impl OneFrame<'_> {
             rendered
         };
         let lent = lend(&pictures, rendered).map_err(|e| (Stage::Inputs, HostError::bad(e)))?;
-        lent.map_err(at(Stage::Render))
+        // An instance kept idle for the next request holds no maps meanwhile.
+        let purged = inst.purge_caches();
+        let rendered = lent.map_err(at(Stage::Render))?;
+        purged.map_err(at(Stage::Render))?;
+        Ok(rendered)
     }
 }
 
