@@ -35,6 +35,7 @@ fn morphfx_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render::stmap, m)?)?;
     m.add_function(wrap_pyfunction!(render::params, m)?)?;
     m.add_function(wrap_pyfunction!(render::last_render_seconds, m)?)?;
+    m.add_function(wrap_pyfunction!(render::build, m)?)?;
     m.add_function(wrap_pyfunction!(tools::track, m)?)?;
     m.add_function(wrap_pyfunction!(tools::snap, m)?)?;
     m.add_function(wrap_pyfunction!(tools::suggest, m)?)?;

@@ -361,6 +361,16 @@ fn map_source<'b>(
     Ok(rows)
 }
 
+/// Which build of the plugin renders: `"x86-64-v3 build with AVX2 and
+/// FMA"` where the CPU has them (the module carries that build beside its
+/// own), else `"baseline x86-64 build"`.
+#[pyfunction]
+pub fn build(py: Python<'_>) -> PyResult<String> {
+    let bundle = bundle(py)?;
+    py.detach(|| instance(bundle, Node::Morph).map(|inst| inst.build_that_ran()))
+        .map_err(errors::render)
+}
+
 /// Every param of node `"morph"` or `"warp"`, one line each as `morphfx
 /// params` prints them: id, type, default and range.
 #[pyfunction]

@@ -1,6 +1,7 @@
 """Scenes, images, errors and threads: the module's own promises."""
 
 import json
+import os
 import struct
 import threading
 import zlib
@@ -225,3 +226,23 @@ def test_threads_that_render_first_all_at_once_finish(tmp_path):
         done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
                               timeout=60)
         assert done.returncode == 0 and done.stdout.strip() == "16", done.stderr
+
+
+def test_the_fast_build_renders_where_the_cpu_runs_it():
+    """The module carries the plugin's x86-64-v3 build beside its own, and
+    hands renders to it on a CPU with AVX2 and FMA, as the bundle does;
+    MORPHFX_CPU=baseline keeps the baseline build."""
+    import platform
+    import subprocess
+    import sys
+    flags = ""
+    if platform.machine() == "x86_64":
+        with open("/proc/cpuinfo") as f:
+            flags = next((l for l in f if l.startswith("flags")), "")
+    fast = {"avx2", "fma"} <= set(flags.split())
+    expected = "x86-64-v3 build with AVX2 and FMA" if fast else "baseline x86-64 build"
+    assert morphfx.build() == expected
+    done = subprocess.run([sys.executable, "-c", "import morphfx; print(morphfx.build())"],
+                          capture_output=True, text=True, env={**os.environ,
+                                                               "MORPHFX_CPU": "baseline"})
+    assert done.stdout.strip() == "baseline x86-64 build", done.stderr

@@ -67,19 +67,42 @@ pub fn check(morphfx: &Path, bundle: &Path) -> Option<String> {
         .into_iter()
         .flatten()
         .flatten()
-        .any(|w| w.file_name().to_string_lossy().contains("-cp39-abi3-"));
-    if !abi3 {
+        .map(|w| w.path())
+        .find(|w| w.to_string_lossy().contains("-cp39-abi3-"));
+    let Some(abi3) = abi3 else {
         eprintln!(
             "python module check failed: no stable-ABI (cp39-abi3) wheel in {}",
             wheels.display()
         );
         exit(1);
+    };
+    // On x86-64 the wheel carries the plugin's x86-64-v3 build beside the module.
+    if cfg!(target_arch = "x86_64") && !wheel_holds(&bin, &abi3, "morphfx/MorphFX-x86-64-v3.so") {
+        eprintln!(
+            "python module check failed: {} lacks the plugin's x86-64-v3 build",
+            abi3.display()
+        );
+        exit(1);
     }
     println!(
         "python module check: pip install ./python, its tests pass, and `cargo xtask wheel` \
-         makes an abi3 wheel"
+         makes an abi3 wheel with the plugin's x86-64-v3 build"
     );
     None
+}
+
+/// Whether the wheel (a zip) at `wheel` holds `name`, asked of Python's
+/// own zipfile module.
+fn wheel_holds(bin: &Path, wheel: &Path, name: &str) -> bool {
+    Command::new(bin.join("python"))
+        .args([
+            "-c",
+            "import sys, zipfile; sys.exit(sys.argv[2] not in zipfile.ZipFile(sys.argv[1]).namelist())",
+        ])
+        .arg(wheel)
+        .arg(name)
+        .status()
+        .is_ok_and(|s| s.success())
 }
 
 /// `cargo xtask wheel`: the module's wheel (release build, abi3: one wheel

@@ -98,7 +98,7 @@ pub fn drag(
             the bundle's {} ran",
         size.0,
         size.1,
-        build_that_ran(&inst)
+        inst.build_that_ran()
     );
     for scale in [1.0, 0.5] {
         let spec = OutputSpec {
@@ -133,18 +133,4 @@ pub fn drag(
         );
     }
     Ok(())
-}
-
-/// Which build of the plugin answers: its description ends with it, in
-/// brackets (a v3 build is about twice as fast as the baseline one, which
-/// a checkout without `cargo xtask bundle --release` runs).
-fn build_that_ran(inst: &crate::host::Instance<'_>) -> String {
-    let text = inst
-        .descriptor_props()
-        .str(openfx::sys::generic::core::kOfxPropPluginDescription)
-        .unwrap_or_default();
-    let build = text
-        .rsplit_once('(')
-        .map(|(_, b)| b.trim_end_matches(['.', ')']));
-    build.unwrap_or("unnamed build").to_string()
 }

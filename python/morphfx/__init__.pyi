@@ -23,6 +23,7 @@ __all__ = [
     "stmap",
     "params",
     "last_render_seconds",
+    "build",
     "track",
     "snap",
     "suggest",
@@ -106,6 +107,7 @@ def stmap(
 ) -> _Image: ...
 def params(node: str = "morph") -> List[str]: ...
 def last_render_seconds() -> float: ...
+def build() -> str: ...
 def track(
     scene: _SceneLike,
     a: Union[_Path, Sequence[_Picture]],
