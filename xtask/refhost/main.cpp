@@ -818,6 +818,58 @@ void checkMotion(Effect &fx, const Where &w) {
   count->set(lines);
 }
 
+/// The index of choice param `name`'s option `option`, or -1.
+int choiceIndex(IE::Instance &fx, const std::string &name, const std::string &option) {
+  auto *p = fx.getParam(name);
+  for (int k = 0; p && k < choiceCount(fx, name); ++k)
+    if (p->getProperties().getStringProperty(kOfxParamPropChoiceOption, k) == option) return k;
+  return -1;
+}
+
+/// The Filter's `nearest` option through the library: the warped source
+/// holds only values the source holds (IDs stay IDs), moved by the warp.
+/// Morph shows its warped B (a checkerboard of two colours), Warp its
+/// source (a ramp whose values are pixel centres over the frame).
+void checkNearest(Effect &fx, const Where &w) {
+  auto *filter = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("filter"));
+  auto *view = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx.getParam("view"));
+  const int nearest = choiceIndex(fx, "filter", "nearest");
+  const bool morph = inputClips(fx).size() == 2;
+  const int picture = morph ? choiceIndex(fx, "view", "warped-b") : 0;
+  if (!filter || !view || nearest < 0 || picture < 0)
+    return fail(w.text + ": no filter option nearest or no warped-b view");
+  filter->set(nearest);
+  view->set(picture);
+  const Render out = render(fx, {1, 1}, w.with("nearest"));
+  const std::vector<float> px = outputPixels(fx);
+  filter->set(0);
+  view->set(0);
+  if (!out.ok) return;
+  const auto near = [](double v, double to) { return std::fabs(v - to) < 1e-5; };
+  const auto centre = [&](double v, int n) {
+    return near(v * n - 0.5, std::round(v * n - 0.5));
+  };
+  const std::string shown = inputClips(fx).back();
+  const OfxRectI &b = fx.renderWindow;
+  size_t k = 0;
+  int moved = 0;
+  for (int y = b.y1; y < b.y2; ++y)
+    for (int x = b.x1; x < b.x2; ++x, k += 4) {
+      const float r = px[k], g = px[k + 1], bl = px[k + 2];
+      const bool source =
+          morph ? (near(r, 0.9) && near(bl, 0.2)) || (near(r, 0.1) && near(bl, 0.8))
+                : centre(r, kProjectWidth) && centre(g, kProjectHeight);
+      if (!source) {
+        std::ostringstream m;
+        m << w.text << ": nearest gave (" << r << ", " << g << ", " << bl << ") at (" << x
+          << ", " << y << "), no source value";
+        return fail(m.str());
+      }
+      moved += !near(r, sourceValue(shown, x + 0.5, y + 0.5, 0));
+    }
+  if (moved == 0) fail(w.text + ": nearest: the warp moved nothing");
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -849,6 +901,7 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
     checkMattes(*fx, w.with("mattes"));
     checkDrag(*fx, w.with("drag"));
     checkMotion(*fx, w.with("motion"));
+    checkNearest(*fx, w.with("filter"));
     loadScene(*fx, w);
   }
 
