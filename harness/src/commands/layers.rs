@@ -38,11 +38,15 @@ impl LayerChoice {
     /// (`rgba`), which renders as any warp does.
     pub fn parse(spec: &str, ids: &str) -> Result<Option<LayerChoice>, HostError> {
         let names = match spec.trim() {
-            "" => return Err(HostError::bad("--layers: expected rgba, all or a list")),
             RGBA => return Ok(None),
             "all" => None,
             other => Some(list(other)),
         };
+        if names.as_ref().is_some_and(Vec::is_empty) {
+            return Err(HostError::bad(format!(
+                "--layers {spec:?}: expected rgba, all or a list of layer names"
+            )));
+        }
         Ok(Some(LayerChoice {
             names,
             ids: list(ids),

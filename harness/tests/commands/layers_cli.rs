@@ -254,6 +254,44 @@ fn layers_refuse_what_they_cannot_do_with_exit_2() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("no such layer (it has rgba, N)"), "{err}");
     assert!(!exr.exists(), "nothing written");
+    for spec in ["", ","] {
+        let args = [
+            "warp",
+            "--line",
+            LINE,
+            "--input",
+            s(&multi),
+            "--layers",
+            spec,
+            "-o",
+            s(&exr),
+        ];
+        let (code, err) = morphfx(&args);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("expected rgba, all or a list"), "{err}");
+    }
+    // A damaged file: named, exit 2, nothing written.
+    let bytes = std::fs::read(&multi).unwrap();
+    let cut = d.join("cut.exr");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let args = [
+        "warp",
+        "--line",
+        LINE,
+        "--input",
+        s(&cut),
+        "--layers",
+        "all",
+        "-o",
+        s(&exr),
+    ];
+    let (code, err) = morphfx(&args);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("cut.exr") && err.contains("truncated"),
+        "{err}"
+    );
+    assert!(!exr.exists(), "nothing written");
 }
 
 #[test]
