@@ -212,86 +212,45 @@ fn layers_refuse_what_they_cannot_do_with_exit_2() {
         &multi,
         &[("R", "R"), ("G", "G"), ("B", "B"), ("N.X", "N.X")],
     );
-    let png = d.join("out.png");
-    let exr = d.join("out.exr");
-    for (extra, says) in [
-        (vec!["-o", s(&png)], "must be an EXR"),
-        (
-            vec!["-o", s(&exr), "--view", "stmap"],
-            "--view stmap takes no layers",
-        ),
-        (
-            vec!["-o", s(&exr), "--stmap", s(&png)],
-            "write the ST map in a run of its own",
-        ),
-    ] {
+    let bytes = std::fs::read(&multi).unwrap();
+    let cut = d.join("cut.exr");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let (png, exr) = (d.join("out.png"), d.join("out.exr"));
+    // `warp --line LINE --input INPUT --layers LAYERS MORE...` must exit 2
+    // saying `says`, with nothing written.
+    let refused = |input: &Path, layers: &str, more: &[&str], says: &str| {
         let mut args = vec![
             "warp",
             "--line",
             LINE,
             "--input",
-            s(&multi),
+            s(input),
             "--layers",
-            "all",
+            layers,
         ];
-        args.extend(extra);
+        args.extend(more);
         let (code, err) = morphfx(&args);
         assert_eq!(code, 2, "{args:?}: {err}");
-        assert!(err.contains(says), "{err}");
-    }
-    let args = [
-        "warp",
-        "--line",
-        LINE,
-        "--input",
-        s(&multi),
-        "--layers",
-        "P",
-        "-o",
-        s(&exr),
-    ];
-    let (code, err) = morphfx(&args);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("no such layer (it has rgba, N)"), "{err}");
-    assert!(!exr.exists(), "nothing written");
-    for spec in ["", ","] {
-        let args = [
-            "warp",
-            "--line",
-            LINE,
-            "--input",
-            s(&multi),
-            "--layers",
-            spec,
-            "-o",
-            s(&exr),
-        ];
-        let (code, err) = morphfx(&args);
-        assert_eq!(code, 2, "{err}");
-        assert!(err.contains("expected rgba, all or a list"), "{err}");
-    }
-    // A damaged file: named, exit 2, nothing written.
-    let bytes = std::fs::read(&multi).unwrap();
-    let cut = d.join("cut.exr");
-    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let args = [
-        "warp",
-        "--line",
-        LINE,
-        "--input",
-        s(&cut),
-        "--layers",
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!exr.exists() && !png.exists(), "nothing written");
+    };
+    refused(&multi, "all", &["-o", s(&png)], "must be an EXR");
+    let view = ["-o", s(&exr), "--view", "stmap"];
+    refused(&multi, "all", &view, "--view stmap takes no layers");
+    let stmap = ["-o", s(&exr), "--stmap", s(&png)];
+    refused(
+        &multi,
         "all",
-        "-o",
-        s(&exr),
-    ];
-    let (code, err) = morphfx(&args);
-    assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("cut.exr") && err.contains("truncated"),
-        "{err}"
+        &stmap,
+        "write the ST map in a run of its own",
     );
-    assert!(!exr.exists(), "nothing written");
+    let out = ["-o", s(&exr)];
+    refused(&multi, "P", &out, "no such layer (it has rgba, N)");
+    for spec in ["", ","] {
+        refused(&multi, spec, &out, "expected rgba, all or a list");
+    }
+    refused(&cut, "all", &out, "truncated");
+    refused(&cut, "all", &out, "cut.exr");
 }
 
 #[test]
