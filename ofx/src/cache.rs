@@ -230,6 +230,19 @@ impl<T: Weigh + Send + Sync + 'static> Cache<T> {
         }
     }
 
+    /// Takes `key`'s value out of the cache, when it is made: whoever
+    /// holds the last `Arc` may then edit it in place instead of copying.
+    pub fn take(&self, key: &Key) -> Option<Arc<T>> {
+        let entry = {
+            let mut entries = self.entries();
+            let at = entries.iter().position(|e| e.key == *key && e.bytes > 0)?;
+            entries.swap_remove(at)
+        };
+        USED.fetch_sub(entry.bytes, Ordering::AcqRel);
+        let value = entry.slot.locked().take();
+        value
+    }
+
     pub fn clear(&self) {
         let freed: usize = self.entries().drain(..).map(|e| e.bytes).sum();
         USED.fetch_sub(freed, Ordering::AcqRel);
@@ -282,6 +295,38 @@ mod tests {
             }
         });
         assert_eq!(calls.load(std::sync::atomic::Ordering::SeqCst), 1);
+    }
+
+    /// A value taken out is the caller's alone: its bytes leave the
+    /// budget, the key misses afterwards, and nothing is taken twice.
+    #[test]
+    fn a_taken_value_leaves_the_cache_and_its_budget() {
+        let cache = WarpCache::default();
+        let made = cache
+            .get_or_compute::<()>(Key::of(&"a"), || Ok(map(64)))
+            .unwrap();
+        cache
+            .get_or_compute::<()>(Key::of(&"b"), || Ok(map(8)))
+            .unwrap();
+        assert_eq!(cache.bytes(), 72 * 8);
+        let taken = cache.take(&Key::of(&"a")).expect("made, so taken");
+        assert!(Arc::ptr_eq(&taken, &made));
+        drop(made);
+        assert!(Arc::try_unwrap(taken).is_ok(), "no other holder");
+        assert_eq!(cache.bytes(), 8 * 8);
+        assert!(cache.take(&Key::of(&"a")).is_none());
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        cache
+            .get_or_compute::<()>(Key::of(&"a"), || {
+                calls.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                Ok(map(64))
+            })
+            .unwrap();
+        assert_eq!(
+            calls.load(std::sync::atomic::Ordering::SeqCst),
+            1,
+            "made again"
+        );
     }
 
     /// Keys differ wherever their inputs' bits do, however close the values.

@@ -66,6 +66,16 @@ impl WarpMap {
         Some(&self.positions[start..start + w])
     }
 
+    /// Every position, rows bottom-up (empty for the identity map).
+    pub fn positions(&self) -> &[[f32; 2]] {
+        &self.positions
+    }
+
+    /// The positions, to be edited into another map of the same window.
+    pub fn into_positions(self) -> Vec<[f32; 2]> {
+        self.positions
+    }
+
     /// Heap bytes held (for cache budgets).
     pub fn memory_bytes(&self) -> usize {
         self.positions.len() * std::mem::size_of::<[f32; 2]>()

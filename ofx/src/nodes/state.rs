@@ -18,6 +18,9 @@ use ofx_layer::params::Params;
 use ofx_layer::plugin::Context;
 use ofx_layer::sync::Locked;
 
+/// A side's last field map, by its cache key.
+type LastField = (Key, Weak<FieldMap>);
+
 pub struct NodeState {
     pub kind: &'static NodeKind,
     /// The context the host made the instance in.
@@ -28,9 +31,9 @@ pub struct NodeState {
     /// Viewer renders' `field` maps with the sums that redo them after a
     /// line moves, keyed like the warps.
     pub field_maps: Cache<FieldMap>,
-    /// Each side's last field map, while the cache holds it: what the next
-    /// viewer render redoes.
-    last_field: Mutex<[Weak<FieldMap>; 2]>,
+    /// Each side's last field map and its key, while the cache holds it:
+    /// what the next viewer render redoes.
+    last_field: Mutex<[Option<LastField>; 2]>,
     /// The last scene parsed, keyed by where it came from (text, or path + mtime + size).
     pub scene: Mutex<Option<(String, Arc<Scene>)>>,
     /// Warnings already posted (minimal hosts: report each fallback once).
@@ -103,16 +106,18 @@ impl NodeState {
         self.weights.clear();
     }
 
-    /// `side`'s last field map, if the cache still holds it.
-    pub fn last_field(&self, side: Side) -> Option<Arc<FieldMap>> {
+    /// `side`'s last field map and its key, if the cache still holds it.
+    pub fn last_field(&self, side: Side) -> Option<(Key, Arc<FieldMap>)> {
         let last = self.last_field.locked();
-        last[side_index(side)].upgrade()
+        let (key, map) = last[side_index(side)].as_ref()?;
+        Some((key.clone(), map.upgrade()?))
     }
 
-    /// Makes `map` the one the next viewer render of `side` redoes.
-    pub fn set_last_field(&self, side: Side, map: &Arc<FieldMap>) {
+    /// Makes `map`, cached under `key`, the one the next viewer render of
+    /// `side` redoes.
+    pub fn set_last_field(&self, side: Side, key: Key, map: &Arc<FieldMap>) {
         let mut last = self.last_field.locked();
-        last[side_index(side)] = Arc::downgrade(map);
+        last[side_index(side)] = Some((key, Arc::downgrade(map)));
     }
 
     /// True the first time `what` is asked about.

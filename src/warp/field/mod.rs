@@ -1,6 +1,7 @@
 //! Beier-Neely field warping (Beier-Neely §3): every directed line pair pulls
 //! nearby pixels along with it, weighted by eq. (4).
 
+mod grid;
 mod kernel;
 mod lines;
 mod redo;

@@ -159,3 +159,103 @@ fn maps_are_made_afresh_when_the_setup_or_many_lines_change() {
         "a line fewer"
     );
 }
+
+/// Long drags of many lines at both scales, with small and large steps:
+/// what waits in the blocks' lags, and what their pixels took from a grid,
+/// keeps every map within tolerance of the exact one.
+#[test]
+fn long_drags_with_changes_waiting_far_away_stay_within_tolerance() {
+    let tolerance = Evaluation::DEFAULT_TOLERANCE;
+    for seed in 0..6u64 {
+        let steps = [
+            (1.0, v(0.7, 0.3)),
+            (0.5, v(-3.0, 5.0)),
+            (1.0, v(14.0, 9.0)),
+            (0.5, v(0.5, 0.5)),
+        ];
+        for (scale, by) in steps {
+            let (window, scale) = window_at(scale);
+            let n = 10 + (seed as usize * 7) % 50;
+            let mut pairs = spread_pairs(seed + 100, n, 640.0, 360.0);
+            let mut kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+            for step in 1..=30u32 {
+                pairs = drag(&pairs, (seed as usize + step as usize / 10) % n, by);
+                let warp = FieldWarp::new(pairs.clone(), &adaptive());
+                assert!(warp.redoes(window, scale, &kept));
+                kept = warp.field_map_from(window, scale, kept);
+                if step % 10 == 0 {
+                    let truth =
+                        FieldWarp::new(pairs.clone(), &exact(0.001)).map_window(window, scale);
+                    let err = worst_px(kept.map(), &truth);
+                    assert!(
+                        err <= tolerance,
+                        "seed {seed}, scale {}, step {by:?} × {step}: {err} px > {tolerance}",
+                        scale.x
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A nudge of one line among many rewrites the pixels near it and leaves
+/// those far from it as they were, bit for bit: their share of the change
+/// waits in their blocks' lags.
+#[test]
+fn a_nudge_leaves_pixels_far_from_the_line_untouched() {
+    let (window, scale) = (RectI::new(0, 0, 1280, 720), PixelScale::UNIT);
+    let pairs = spread_pairs(11, 80, 1280.0, 720.0);
+    let before = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+    let nudged = drag(&pairs, 5, v(0.2, 0.1));
+    let warp = FieldWarp::new(nudged.clone(), &adaptive());
+    let after = warp.field_map_after(window, scale, Some(&before));
+    assert_eq!(after.redos(), 1);
+    let (old, new) = (pairs[5].dst, nudged[5].dst);
+    let (mut far, mut far_moved, mut near_moved) = (0, 0, 0);
+    for j in window.y1..window.y2 {
+        for i in window.x1..window.x2 {
+            let c = scale.pixel_centre(i, j);
+            let d = c
+                .distance_to_segment(old.0, old.1)
+                .min(c.distance_to_segment(new.0, new.1));
+            let moved = before.map().get(i, j) != after.map().get(i, j);
+            if d > 400.0 {
+                far += 1;
+                far_moved += usize::from(moved);
+            } else if d < 20.0 {
+                near_moved += usize::from(moved);
+            }
+        }
+    }
+    assert!(
+        far > 100_000,
+        "the test needs pixels far from the line: {far}"
+    );
+    assert_eq!(far_moved, 0, "of {far} pixels over 400 px from the line");
+    assert!(
+        near_moved > 1000,
+        "the pixels near the line moved: {near_moved}"
+    );
+    let truth = FieldWarp::new(nudged, &exact(0.001)).map_window(window, scale);
+    let err = worst_px(after.map(), &truth);
+    assert!(err <= Evaluation::DEFAULT_TOLERANCE, "{err} px from exact");
+}
+
+/// Handing the map over edits it in place into the map a redo of a copy
+/// of it makes.
+#[test]
+fn a_map_handed_over_is_redone_as_a_copy_of_it_is() {
+    let (window, scale) = window_at(1.0);
+    let pairs = spread_pairs(12, 40, 640.0, 360.0);
+    let make = || FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+    let (mut copied, mut handed) = (make(), make());
+    let mut moved = pairs.clone();
+    for step in 0..8 {
+        moved = drag(&moved, step % 3, v(1.5, -0.5));
+        let warp = FieldWarp::new(moved.clone(), &adaptive());
+        copied = warp.field_map_after(window, scale, Some(&copied));
+        handed = warp.field_map_from(window, scale, handed);
+        assert_eq!(copied.redos(), handed.redos());
+        assert_eq!(**copied.map(), **handed.map(), "step {step}");
+    }
+}

@@ -12,17 +12,14 @@
 use rayon::prelude::*;
 use wide::f32x8;
 
+use super::grid::{self, Grid, Rows, GRID};
 use super::kernel::{Lines, Sums};
 use super::warp::FieldWarp;
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
 
 /// Side of a block, pixels.
-const BLOCK: i32 = 48;
-/// Spacing of the far-field grid, pixels.
-const GRID: i32 = 4;
-/// Pixel offsets within a grid cell, as fractions of it.
-const FRACTIONS: [f32; GRID as usize] = [0.0, 0.25, 0.5, 0.75];
+pub(super) const BLOCK: i32 = 48;
 /// Lines closer than this to a block (pixels) are evaluated exactly there.
 /// At this distance a far line's relative curvature over a grid cell is
 /// about `0.75·(GRID/NEAR)² ≈ 7e-4`.
@@ -40,9 +37,7 @@ pub(super) fn map_window(
     let mut pos = vec![[0f32; 2]; window.area()];
     let setup = Setup::new(warp, window, scale, Some(tolerance));
     let mut made = vec![false; setup.block_count()];
-    setup.each_band(&mut pos, None, &mut made, |band, _, made| {
-        fill_band(band, made)
-    });
+    setup.each_band(&mut pos, None, &mut made, fill_band);
     WarpMap::new(window, scale, pos)
 }
 
@@ -86,7 +81,8 @@ impl<'a> Setup<'a> {
         }
     }
 
-    fn blocks_across(&self) -> usize {
+    /// Blocks in a band.
+    pub fn blocks_across(&self) -> usize {
         self.window.width().div_ceil(BLOCK as usize)
     }
 
@@ -101,16 +97,15 @@ impl<'a> Setup<'a> {
         self.blocks_across() * self.window.height().div_ceil(BLOCK as usize)
     }
 
-    /// Runs `f(band, first, made)` on every row of blocks (a band), in
-    /// parallel, into `pos` and, when kept, `weights` (`Σ w` per pixel):
-    /// `first` numbers the band's first block, and `made` has one entry
-    /// per block of the band, for whether its far field was interpolated.
-    pub fn each_band(
+    /// Runs `f(band, blocks)` on every row of blocks (a band), in parallel,
+    /// into `pos` and, when kept, `weights` (`Σ w` per pixel): `blocks` is
+    /// the band's share of `per_block`, one entry per block from the left.
+    pub fn each_band<T: Send>(
         &self,
         pos: &mut [[f32; 2]],
         weights: Option<&mut [f32]>,
-        made: &mut [bool],
-        f: impl Fn(&mut Band, usize, &mut [bool]) + Sync,
+        per_block: &mut [T],
+        f: impl Fn(&mut Band, &mut [T]) + Sync,
     ) {
         let (w, across) = (self.window.width(), self.blocks_across());
         if w == 0 || self.window.height() == 0 {
@@ -123,9 +118,9 @@ impl<'a> Setup<'a> {
         };
         pos.par_chunks_mut(rows)
             .zip(weight_bands)
-            .zip(made.par_chunks_mut(across))
+            .zip(per_block.par_chunks_mut(across))
             .enumerate()
-            .for_each(|(row, ((out, weights), made))| {
+            .for_each(|(row, ((out, weights), blocks))| {
                 let y1 = self.window.y1 + row as i32 * BLOCK;
                 let mut band = Band {
                     setup: self,
@@ -135,8 +130,14 @@ impl<'a> Setup<'a> {
                     weights,
                     scratch: Scratch::default(),
                 };
-                f(&mut band, row * across, made);
+                f(&mut band, blocks);
             });
+    }
+
+    /// What the check points must meet per axis (canonical units), when
+    /// the evaluation is adaptive.
+    pub fn tolerance(&self) -> Option<[f32; 2]> {
+        self.tol
     }
 }
 
@@ -160,21 +161,33 @@ pub(super) struct Band<'a> {
 }
 
 impl Band<'_> {
+    /// The pixels of block `k` of the band, from the left.
+    pub fn rect(&self, k: usize) -> RectI {
+        let (x1, cols) = (self.setup.window.x1, self.setup.block_columns(k));
+        RectI::new(
+            x1 + cols.start as i32,
+            self.y1,
+            x1 + cols.end as i32,
+            self.y2,
+        )
+    }
+
     /// Block `k` of the band, from the left.
     pub fn block(&mut self, k: usize) -> Block<'_> {
-        let (x1, cols) = (self.setup.window.x1, self.setup.block_columns(k));
         Block {
             setup: self.setup,
-            rect: RectI::new(
-                x1 + cols.start as i32,
-                self.y1,
-                x1 + cols.end as i32,
-                self.y2,
-            ),
+            rect: self.rect(k),
             out: &mut *self.out,
             weights: self.weights.as_deref_mut(),
             scratch: &mut self.scratch,
         }
+    }
+
+    /// Pixel `(i, j)`'s position and `Σ w` (0 when not kept).
+    pub fn at(&self, i: i32, j: i32) -> ([f32; 2], f32) {
+        let w = self.setup.window.width();
+        let k = (j - self.y1) as usize * w + (i - self.setup.window.x1) as usize;
+        (self.out[k], self.weights.as_ref().map_or(0.0, |ws| ws[k]))
     }
 
     /// Row `j` across the window: positions and `Σ w` (when kept).
@@ -214,7 +227,7 @@ struct Scratch {
     ox: Vec<f32>,
     oy: Vec<f32>,
     ow: Vec<f32>,
-    far: FarRows,
+    far: Rows<3>,
     sets: Sets,
 }
 
@@ -237,7 +250,7 @@ impl Block<'_> {
             self.exact();
             return false;
         }
-        let (lo, hi) = self.corners();
+        let (lo, hi) = corners(self.rect);
         let mut sets = std::mem::take(&mut self.scratch.sets);
         sets.near_idx.clear();
         sets.far_idx.clear();
@@ -264,15 +277,6 @@ impl Block<'_> {
         }
         self.exact();
         false
-    }
-
-    /// The centres of the block's corner pixels (pixel space).
-    fn corners(&self) -> (Vec2, Vec2) {
-        let b = self.rect;
-        (
-            Vec2::new(b.x1 as f64 + 0.5, b.y1 as f64 + 0.5),
-            Vec2::new(b.x2 as f64 - 0.5, b.y2 as f64 - 0.5),
-        )
     }
 
     /// Canonical position of the centre of pixel `(i, j)`.
@@ -304,31 +308,21 @@ impl Block<'_> {
         self.rows(&self.setup.warp.kernel, None);
     }
 
-    /// `lines`' sums on grid nodes `(x1 + a·GRID, y1 + c·GRID)`, which
-    /// reach up to one cell past the block's far edges.
-    fn far_grid(&self, lines: &Lines) -> Grid {
-        let b = self.rect;
-        let nx = (b.width() as i32 + GRID - 1) / GRID + 1;
-        let ny = (b.height() as i32 + GRID - 1) / GRID + 1;
-        let (mut xs, mut ys) = (Vec::new(), Vec::new());
-        for c in 0..ny {
-            for a in 0..nx {
-                let (x, y) = self.centre(b.x1 + a * GRID, b.y1 + c * GRID);
-                xs.push(x);
-                ys.push(y);
-            }
-        }
+    /// `lines`' sums on the block's grid nodes ([`grid::nodes`]).
+    fn far_grid(&self, lines: &Lines) -> Grid<3> {
+        let (xs, ys, nx) = grid::nodes(self.rect, self.setup.scale, GRID);
         let mut sums = vec![[0f32; 3]; xs.len()];
         lines.sums(&xs, &ys, &mut sums);
         Grid {
-            nx: nx as usize,
+            nx,
+            spacing: GRID,
             sums,
         }
     }
 
     /// Each row of the block through `lines`, plus the far field from `grid`
     /// when there is one.
-    fn rows(&mut self, lines: &Lines, grid: Option<&Grid>) {
+    fn rows(&mut self, lines: &Lines, grid: Option<&Grid<3>>) {
         let b = self.rect;
         let n = b.width();
         let mut sc = std::mem::take(self.scratch);
@@ -346,7 +340,7 @@ impl Block<'_> {
             sc.ys.fill(self.centre(b.x1, j).1);
             let far = match grid {
                 Some(_) => sc.far.row((j - b.y1) as usize),
-                None => &sc.far.row,
+                None => sc.far.last(),
             };
             let lanes = |k: usize| {
                 let lane = |m: usize| f32x8::new(far[m][k..k + 8].try_into().expect("8 lanes"));
@@ -376,16 +370,7 @@ impl Block<'_> {
             return true;
         };
         let b = self.rect;
-        let mut pixels = Vec::new();
-        let mut j = b.y1 + GRID / 2;
-        while j < b.y2 {
-            let mut i = b.x1 + GRID / 2;
-            while i < b.x2 {
-                pixels.push((i, j));
-                i += 2 * GRID;
-            }
-            j += 2 * GRID;
-        }
+        let pixels: Vec<(i32, i32)> = check_points(b).collect();
         let (xs, ys): (Vec<f32>, Vec<f32>) = pixels.iter().map(|&(i, j)| self.centre(i, j)).unzip();
         let (mut ox, mut oy) = (vec![0f32; xs.len()], vec![0f32; xs.len()]);
         self.setup
@@ -399,70 +384,25 @@ impl Block<'_> {
     }
 }
 
-/// Sums on a grid of `nx` nodes per row.
-struct Grid {
-    nx: usize,
-    sums: Vec<[f32; 3]>,
+/// The centres of a block's corner pixels (pixel space).
+pub(super) fn corners(block: RectI) -> (Vec2, Vec2) {
+    let b = block;
+    (
+        Vec2::new(b.x1 as f64 + 0.5, b.y1 as f64 + 0.5),
+        Vec2::new(b.x2 as f64 - 0.5, b.y2 as f64 - 0.5),
+    )
 }
 
-/// A grid's sums interpolated over a block: along each grid row once per
-/// block, then between two grid rows per pixel row, loops over whole rows
-/// that vectorise.
-#[derive(Default)]
-struct FarRows {
-    /// Sums along each grid row: `[(row * 3 + m) * stride + k]`.
-    across: Vec<f32>,
-    stride: usize,
-    /// One pixel row's sums, one vector per component, padded to whole lanes.
-    row: [Vec<f32>; 3],
-}
-
-impl FarRows {
-    /// Interpolates `grid` along its rows for a block `n` pixels wide.
-    fn across(&mut self, grid: &Grid, n: usize) {
-        self.zero(n);
-        let ny = grid.sums.len() / grid.nx;
-        self.across.clear();
-        self.across.resize(ny * 3 * self.stride, 0.0);
-        for (c, nodes) in grid.sums.chunks_exact(grid.nx).enumerate() {
-            for m in 0..3 {
-                let at = (c * 3 + m) * self.stride;
-                let row = &mut self.across[at..at + self.stride];
-                for (cell, w) in row.chunks_exact_mut(GRID as usize).zip(nodes.windows(2)) {
-                    let (a, d) = (w[0][m], w[1][m] - w[0][m]);
-                    for (o, f) in cell.iter_mut().zip(FRACTIONS) {
-                        *o = a + d * f;
-                    }
-                }
-            }
-        }
-    }
-
-    /// Rows of zeros for a block `n` pixels wide (no far field).
-    fn zero(&mut self, n: usize) {
-        self.stride = n + 8;
-        for v in &mut self.row {
-            v.clear();
-            v.resize(self.stride, 0.0);
-        }
-    }
-
-    /// The sums along pixel row `dy` of the block.
-    fn row(&mut self, dy: usize) -> &[Vec<f32>; 3] {
-        let (c, f) = (
-            dy / GRID as usize,
-            (dy % GRID as usize) as f32 / GRID as f32,
-        );
-        let stride = self.stride;
-        for (m, far) in self.row.iter_mut().enumerate() {
-            let lo = &self.across[(c * 3 + m) * stride..][..stride];
-            let hi = &self.across[((c + 1) * 3 + m) * stride..][..stride];
-            for ((o, a), b) in far.iter_mut().zip(lo).zip(hi) {
-                *o = a + (b - a) * f;
-            }
-        }
-        &self.row
-    }
+/// The centres of every other grid cell of `block`, where bilinear
+/// interpolation errs most.
+fn check_points(block: RectI) -> impl Iterator<Item = (i32, i32)> {
+    let step = (2 * GRID) as usize;
+    let ys = (block.y1 + GRID / 2..block.y2).step_by(step);
+    ys.flat_map(move |j| {
+        (block.x1 + GRID / 2..block.x2)
+            .step_by(step)
+            .map(move |i| (i, j))
+    })
 }
 
 /// Whether segment `p→q` comes within [`NEAR`] of the box `[lo, hi]`. Most
@@ -470,12 +410,18 @@ impl FarRows {
 /// the exact distance.
 #[inline]
 fn is_near(p: Vec2, q: Vec2, lo: Vec2, hi: Vec2) -> bool {
+    is_within(p, q, lo, hi, NEAR)
+}
+
+/// Whether segment `p→q` comes within `distance` of the box `[lo, hi]`.
+#[inline]
+pub(super) fn is_within(p: Vec2, q: Vec2, lo: Vec2, hi: Vec2, distance: f64) -> bool {
     let gap_x = (lo.x - p.x.max(q.x)).max(p.x.min(q.x) - hi.x);
     let gap_y = (lo.y - p.y.max(q.y)).max(p.y.min(q.y) - hi.y);
-    if gap_x >= NEAR || gap_y >= NEAR {
+    if gap_x >= distance || gap_y >= distance {
         return false;
     }
-    segment_box_distance(p, q, lo, hi) < NEAR
+    segment_box_distance(p, q, lo, hi) < distance
 }
 
 /// Distance from segment `p→q` to the axis-aligned box `[lo, hi]` (0 when

@@ -547,13 +547,26 @@ fn field_map(
     window: RectI,
     key: Key,
 ) -> Outcome<Arc<WarpMap>> {
-    let inputs = &request.inputs;
-    let kept = instance.field_maps.get_or_compute(key, || {
+    let (inputs, scale) = (&request.inputs, request.out_scale);
+    let kept = instance.field_maps.get_or_compute(key.clone(), || {
         let warp = make_warp::field_toward(&inputs.features, side, inputs.t, &inputs.warp)?;
-        let before = instance.last_field(side);
-        Ok::<_, Failure>(warp.field_map_after(window, request.out_scale, before.as_deref()))
+        let map = match instance.last_field(side) {
+            Some((last, before)) if warp.redoes(window, scale, &before) => {
+                drop(before);
+                // Taken out of the cache, the map before is edited in place
+                // (it is the drag's last step, not worth keeping), unless a
+                // render elsewhere still holds it.
+                match instance.field_maps.take(&last).map(Arc::try_unwrap) {
+                    Some(Ok(owned)) => warp.field_map_from(window, scale, owned),
+                    Some(Err(shared)) => warp.field_map_after(window, scale, Some(&shared)),
+                    None => warp.field_map(window, scale),
+                }
+            }
+            _ => warp.field_map(window, scale),
+        };
+        Ok::<_, Failure>(map)
     })?;
-    instance.set_last_field(side, &kept);
+    instance.set_last_field(side, key, &kept);
     Ok(kept.map().clone())
 }
 
