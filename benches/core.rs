@@ -100,6 +100,15 @@ fn bench_field(c: &mut Criterion) {
     g.bench_function("adaptive_100_lines_one_moved", |b| {
         b.iter(|| black_box(moved.field_map_after(frame(), PixelScale::UNIT, Some(&kept))))
     });
+    // The same, the map before handed over and edited in place (as the
+    // plugin does while a line is dragged).
+    g.bench_function("adaptive_100_lines_one_moved_in_place", |b| {
+        b.iter_batched(
+            || before.field_map(frame(), PixelScale::UNIT),
+            |kept| black_box(moved.field_map_from(frame(), PixelScale::UNIT, kept)),
+            criterion::BatchSize::LargeInput,
+        )
+    });
     g.finish();
 }
 
