@@ -38,8 +38,18 @@ pub(super) const PADDED: usize = SAMPLES.div_ceil(8) * 8;
 pub(super) const SHARE: f32 = 0.5;
 
 /// One block's lag.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct Lag {
+    due: Due,
+    /// What the block's pixels hold at each sample (position, `Σ w`), as
+    /// they were last written: read while they are in cache, not from a
+    /// map far larger than it at every redo.
+    seen: Seen,
+}
+
+/// What a block's pixels have not taken.
+#[derive(Debug, Clone, Copy)]
+struct Due {
     /// At each grid node: the moved lines' changes `[Δ Σ w·Δx, Δ Σ w·Δy,
     /// Δ Σ w]` summed over the redos since the pixels last took them.
     pending: [[f32; 3]; NODES],
@@ -49,20 +59,24 @@ pub(super) struct Lag {
     /// less what its pixels took (interpolation is linear, so this is the
     /// error of everything interpolated or left out since then).
     owed: [[f32; 3]; CHECKS],
-    /// What the block's pixels hold at each sample (position, `Σ w`), as
-    /// they were last written: read while they are in cache, not from a
-    /// map far larger than it at every redo.
-    seen: [[f32; 3]; SAMPLES],
 }
 
-impl Default for Lag {
+impl Default for Due {
     fn default() -> Self {
-        Lag {
+        Due {
             pending: [[0.0; 3]; NODES],
             waiting: false,
             owed: [[0.0; 3]; CHECKS],
-            seen: [[0.0; 3]; SAMPLES],
         }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Seen([[f32; 3]; SAMPLES]);
+
+impl Default for Seen {
+    fn default() -> Self {
+        Seen([[0.0; 3]; SAMPLES])
     }
 }
 
@@ -160,7 +174,7 @@ impl Lag {
     /// Notes what the block's pixels in `band` hold at `samples`, after
     /// they were written.
     pub fn look(&mut self, band: &Band, samples: &Samples) {
-        for (seen, &(i, j)) in self.seen.iter_mut().zip(&samples.pixels[..samples.len]) {
+        for (seen, &(i, j)) in self.seen.0.iter_mut().zip(&samples.pixels[..samples.len]) {
             let (p, w) = band.at(i, j);
             *seen = [p[0], p[1], w];
         }
@@ -169,9 +183,8 @@ impl Lag {
     /// This redo's `change` at `samples` (the moved lines' change at each),
     /// added to the lag: what the pixels must take now, if the lag would
     /// grow past its share (`allowed` per axis, canonical units) when they
-    /// take nothing, or always when `now`. `None` when even taking it
-    /// leaves too much owed at the check points: the block is to be made
-    /// afresh.
+    /// take nothing, or always when `now`. `None`, the lag left as it was,
+    /// when even taking it would leave too much owed at the check points.
     pub fn add(
         &mut self,
         samples: &Samples,
@@ -179,54 +192,59 @@ impl Lag {
         allowed: [f32; 2],
         now: bool,
     ) -> Option<Take> {
+        let mut due = self.due;
         let (nodes, checks) = change[..samples.len].split_at(samples.nodes);
-        for (p, c) in self.pending.iter_mut().zip(nodes) {
+        for (p, c) in due.pending.iter_mut().zip(nodes) {
             for m in 0..3 {
                 p[m] += c[m];
             }
         }
-        self.waiting = true;
-        for (owed, c) in self.owed.iter_mut().zip(checks) {
+        due.waiting = true;
+        for (owed, c) in due.owed.iter_mut().zip(checks) {
             for m in 0..3 {
                 owed[m] += c[m];
             }
         }
-        if !now && self.within(samples, allowed, true) {
+        if !now && self.within(&due, samples, allowed, true) {
+            self.due = due;
             return Some(Take::Nothing);
         }
         let grid = Grid {
             nx: samples.nx,
             spacing: SPACING,
-            sums: self.pending[..samples.nodes].to_vec(),
+            sums: due.pending[..samples.nodes].to_vec(),
         };
-        for (owed, &(cell, at)) in self.owed.iter_mut().zip(samples.checks()) {
+        for (owed, &(cell, at)) in due.owed.iter_mut().zip(samples.checks()) {
             let taken = grid.at(cell, at);
             for m in 0..3 {
                 owed[m] -= taken[m];
             }
         }
-        self.pending = [[0.0; 3]; NODES];
-        self.waiting = false;
-        self.within(samples, allowed, false)
-            .then_some(Take::Pending(grid))
+        due.pending = [[0.0; 3]; NODES];
+        due.waiting = false;
+        if !self.within(&due, samples, allowed, false) {
+            return None;
+        }
+        self.due = due;
+        Some(Take::Pending(grid))
     }
 
     /// What the pixels must take before an exact change: the pending
     /// changes, if any, interpolated (`None` when that leaves too much
     /// owed, as in [`Lag::add`]).
     pub fn flush(&mut self, samples: &Samples, allowed: [f32; 2]) -> Option<Take> {
-        if !self.waiting {
+        if !self.due.waiting {
             return Some(Take::Nothing);
         }
         self.add(samples, &[[0.0; 3]; SAMPLES], allowed, true)
     }
 
-    /// Whether leaving out what is owed at the check points and, with
+    /// Whether leaving out what `due` owes at the check points and, with
     /// `at_nodes`, what is pending at the nodes, moves no sample's position
     /// by more than `allowed`.
-    fn within(&self, samples: &Samples, allowed: [f32; 2], at_nodes: bool) -> bool {
+    fn within(&self, due: &Due, samples: &Samples, allowed: [f32; 2], at_nodes: bool) -> bool {
         let off = |n: usize, lag: [f32; 3]| {
-            let [px, py, w] = self.seen[n];
+            let [px, py, w] = self.seen.0[n];
             let w1 = w + lag[2];
             let d = [px - samples.xs[n], py - samples.ys[n]];
             (0..2).all(|axis| {
@@ -235,8 +253,8 @@ impl Lag {
                 off.abs() <= allowed[axis]
             })
         };
-        let nodes_ok = !at_nodes || (0..samples.nodes).all(|n| off(n, self.pending[n]));
+        let nodes_ok = !at_nodes || (0..samples.nodes).all(|n| off(n, due.pending[n]));
         let checks = samples.len - samples.nodes;
-        nodes_ok && (0..checks).all(|k| off(samples.nodes + k, self.owed[k]))
+        nodes_ok && (0..checks).all(|k| off(samples.nodes + k, due.owed[k]))
     }
 }

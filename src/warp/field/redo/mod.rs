@@ -309,12 +309,11 @@ impl Moved {
         let (lo, hi) = corners(band.rect(k));
         let close = |&(p, q): &(Vec2, Vec2)| is_within(p, q, lo, hi, CLOSE);
         if !self.segments.iter().any(close) {
-            let before = lag.clone();
             match lag.add(samples, &self.changes_at(samples), allowed, false) {
                 Some(Take::Nothing) => return Some(Plan::Skip),
                 Some(Take::Pending(grid)) => return Some(Plan::Interpolated(grid)),
                 // The change bends too much between the nodes here.
-                None => *lag = before,
+                None => {}
             }
         }
         match lag.flush(samples, allowed)? {
