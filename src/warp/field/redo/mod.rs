@@ -14,9 +14,10 @@
 //!   evaluated on a grid and waits in the block's [`lag`] until leaving it
 //!   out would cost a share of the tolerance; then the pixels take it,
 //!   interpolated. A nudge touches the pixels near the line and few more.
-//! - A block where a pixel's weight changes by a tenth or more (the moved
-//!   line dominates it, and the division would magnify the map's rounding)
-//!   is evaluated afresh.
+//! - A pixel whose weight changes by a tenth or more (the moved line
+//!   dominates it, and the division would magnify the map's rounding) is
+//!   evaluated exactly with every line; its block afresh when such pixels
+//!   are a quarter of it.
 //!
 //! A redo edits the map before in place when it is handed over
 //! ([`FieldWarp::field_map_from`]), so the pixels it leaves alone cost
@@ -355,6 +356,7 @@ impl Moved {
         let lanes = setup.block_columns(0).len().div_ceil(8) * 8;
         let mut ys = vec![0f32; lanes];
         let mut change: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0f32; lanes]);
+        let mut refused = vec![false; lanes];
         for j in band.y1..band.y2 {
             let y = scale.pixel_centre(window.x1, j).y as f32;
             ys.fill(y);
@@ -362,7 +364,12 @@ impl Moved {
             let (out, weights) = band.row_mut(j);
             let weights = weights.expect("a redo keeps weights");
             for (k, step) in steps.iter_mut().enumerate() {
-                let Step::Swap { exact, pending } = step else {
+                let Step::Swap {
+                    exact,
+                    pending,
+                    repair,
+                } = step
+                else {
                     continue;
                 };
                 let cols = setup.block_columns(k);
@@ -385,12 +392,50 @@ impl Moved {
                         RowChange::exact([dx, dy, dw])
                     }
                 };
-                if !swap_terms(xs, y, &by, (&mut out[cols.clone()], &mut weights[cols])) {
+                let pixels = (&mut out[cols.clone()], &mut weights[cols.clone()]);
+                if swap_terms(xs, y, &by, pixels, &mut refused) {
+                    continue;
+                }
+                let at = refused[..n].iter().enumerate().filter(|(_, r)| **r);
+                repair.extend(at.map(|(i, _)| (cols.start + i, j)));
+                if repair.len() > n * n / 4 {
                     *step = Step::Fresh;
                 }
             }
         }
+        for step in &mut steps {
+            if let Step::Swap { repair, .. } = step {
+                self.repair(band, repair);
+            }
+        }
         steps
+    }
+
+    /// Evaluates the pixels at `repair` (column in the window, row) with
+    /// every line, exactly: where the moved lines dominate, a few pixels
+    /// cost less than making their block afresh.
+    fn repair(&self, band: &mut Band, repair: &[(usize, i32)]) {
+        if repair.is_empty() {
+            return;
+        }
+        let setup = band.setup;
+        let x1 = setup.window.x1;
+        let centre = |&(i, j): &(usize, i32)| setup.scale.pixel_centre(x1 + i as i32, j);
+        let xs: Vec<f32> = repair.iter().map(|p| centre(p).x as f32).collect();
+        let ys: Vec<f32> = repair.iter().map(|p| centre(p).y as f32).collect();
+        let (mut ox, mut oy, mut ow) = (
+            vec![0f32; xs.len()],
+            vec![0f32; xs.len()],
+            vec![0f32; xs.len()],
+        );
+        let zero = |_| Default::default();
+        let out = (&mut ox[..], &mut oy[..]);
+        (setup.warp.kernel).map_points_plus(&xs, &ys, zero, out, Some(&mut ow));
+        for (k, &(i, j)) in repair.iter().enumerate() {
+            let (pos, weights) = band.row_mut(j);
+            pos[i] = [ox[k], oy[k]];
+            weights.expect("a redo keeps weights")[i] = ow[k];
+        }
     }
 }
 
@@ -403,6 +448,9 @@ enum Step {
     Swap {
         exact: bool,
         pending: Option<Box<Rows<3>>>,
+        /// Pixels the swap refused, to be evaluated exactly (column in
+        /// the window, row).
+        repair: Vec<(usize, i32)>,
     },
     /// It is evaluated afresh.
     Fresh,
@@ -422,10 +470,12 @@ impl Step {
             Some(Plan::Exact(pending)) => Step::Swap {
                 exact: true,
                 pending: pending.map(rows),
+                repair: Vec::new(),
             },
             Some(Plan::Interpolated(grid)) => Step::Swap {
                 exact: false,
                 pending: Some(rows(grid)),
+                repair: Vec::new(),
             },
         }
     }

@@ -11,20 +11,22 @@ use super::super::grid::Between;
 pub(super) type RowChange<'a> = Between<'a, 3>;
 
 /// Swaps the terms in the pixels of a row `y` at `xs`, their positions
-/// `pos` and `Σ w` `ws` edited in place; false when the old terms carried
-/// a tenth of some pixel's weight or more (taking them away would cancel
-/// digits of its sums), or its weight changes by a tenth or more. One pass
-/// with no early exit and no branch, which the compiler vectorises
-/// (positions come in pairs, which it deinterleaves better than lanes
-/// loaded one by one).
+/// `pos` and `Σ w` `ws` edited in place; `refused[k]` is set for a pixel
+/// whose weight changes by a tenth or more (the moved lines dominate it,
+/// and the division would magnify the map's rounding by `W / W'`), or
+/// was not a finite positive sum, and the result says whether none was.
+/// One pass with no early exit and no branch, which the compiler
+/// vectorises (positions come in pairs, which it deinterleaves better
+/// than lanes loaded one by one).
 pub(super) fn swap_terms(
     xs: &[f32],
     y: f32,
     change: &RowChange,
     (pos, ws): (&mut [[f32; 2]], &mut [f32]),
+    refused: &mut [bool],
 ) -> bool {
     let n = pos.len();
-    let (xs, ws) = (&xs[..n], &mut ws[..n]);
+    let (xs, ws, refused) = (&xs[..n], &mut ws[..n], &mut refused[..n]);
     let [lx, ly, lw] = change.lo.map(|s| &s[..n]);
     let [hx, hy, hw] = change.hi.map(|s| &s[..n]);
     let f = change.f;
@@ -34,9 +36,10 @@ pub(super) fn swap_terms(
         let dw = lw[k] + (hw[k] - lw[k]) * f;
         let (w, p) = (ws[k], pos[k]);
         let w1 = w + dw;
-        let tenth = 0.1 * w;
         // NaNs compare false: they fail here too.
-        good &= (w > 0.0) & (w < f32::INFINITY) & (dw.abs() <= tenth);
+        let ok = (w > 0.0) & (w < f32::INFINITY) & (dw.abs() <= 0.1 * w);
+        refused[k] = !ok;
+        good &= ok;
         let sx = (p[0] - xs[k]) * w + dx;
         let sy = (p[1] - y) * w + dy;
         pos[k] = [xs[k] + sx / w1, y + sy / w1];
