@@ -85,7 +85,14 @@ impl Default for Seen {
 type Place = ((usize, usize), (f32, f32));
 
 /// Where a block's changes are sampled: its grid nodes then its check
-/// points, as canonical positions and the pixels whose sums they read.
+/// points, as canonical positions.
+///
+/// Bilinear interpolation errs most at the centres of a cell's edges or at
+/// its centre: along an edge by `h²/8` times the second derivative along
+/// it, at the centre by the sum of both (so for a term near harmonic, as a
+/// far line's is, the centre alone would see almost nothing). The check
+/// points are all three kinds: the cells' centres, then the centres of
+/// their edges across, then those up, each row by row.
 pub(super) struct Samples {
     /// Positions, padded to whole lanes.
     pub xs: [f32; PADDED],
@@ -93,72 +100,101 @@ pub(super) struct Samples {
     /// Samples in all, and of them nodes.
     pub len: usize,
     nodes: usize,
-    /// Nodes across.
+    /// Nodes across and up.
     nx: usize,
-    /// The pixel each sample reads (nodes past the block's far edges read
-    /// its last row or column).
-    pixels: [(i32, i32); SAMPLES],
-    /// Per check point: the cell it lies in (its lower-left node) and
-    /// where in it (fractions across and up).
-    checks: [Place; CHECKS],
+    ny: usize,
+    /// The block's first pixel and its last.
+    first: (i32, i32),
+    last: (i32, i32),
 }
 
+/// Per kind of check point: its offset from a node (pixels) and its place
+/// in the cell, and whether it needs a next node across and up.
+const KINDS: [((i32, i32), (f32, f32)); 3] = [
+    ((SPACING / 2, SPACING / 2), (0.5, 0.5)),
+    ((SPACING / 2, 0), (0.5, 0.0)),
+    ((0, SPACING / 2), (0.0, 0.5)),
+];
+
 impl Samples {
-    /// The samples of `block` at `scale`. Bilinear interpolation errs most
-    /// at the centres of a cell's edges or at its centre: along an edge by
-    /// `h²/8` times the second derivative along it, at the centre by the
-    /// sum of both (so for a term near harmonic, as a far line's is, the
-    /// centre alone would see almost nothing).
+    /// The samples of `block` at `scale`.
     pub fn of(block: RectI, scale: PixelScale) -> Self {
         let (nodes, nx) = grid::node_count(block, SPACING);
-        let ny = nodes / nx;
         let mut s = Samples {
             xs: [0.0; PADDED],
             ys: [0.0; PADDED],
             len: 0,
             nodes,
             nx,
-            pixels: [(0, 0); SAMPLES],
-            checks: [((0, 0), (0.0, 0.0)); CHECKS],
+            ny: nodes / nx,
+            first: (block.x1, block.y1),
+            last: (block.x2 - 1, block.y2 - 1),
         };
-        let last = (block.x2 - 1, block.y2 - 1);
-        let push = |s: &mut Samples, (i, j): (i32, i32)| {
-            let (n, c) = (s.len, scale.pixel_centre(i, j));
-            (s.xs[n], s.ys[n]) = (c.x as f32, c.y as f32);
-            s.pixels[n] = (i.min(last.0), j.min(last.1));
+        // Every sample lies on a half-spacing lattice: its coordinates,
+        // once per column and row.
+        let half = SPACING / 2;
+        let column = |k: i32| (scale.pixel_centre(block.x1 + k * half, 0).x) as f32;
+        let row = |k: i32| (scale.pixel_centre(0, block.y1 + k * half).y) as f32;
+        let columns: Vec<f32> = (0..2 * nx as i32).map(column).collect();
+        let rows: Vec<f32> = (0..2 * s.ny as i32).map(row).collect();
+        let push = |s: &mut Samples, (a2, c2): (usize, usize)| {
+            (s.xs[s.len], s.ys[s.len]) = (columns[a2], rows[c2]);
             s.len += 1;
         };
         for n in 0..nodes {
-            push(&mut s, grid::node_pixel(block, n, nx, SPACING));
+            push(&mut s, (2 * (n % nx), 2 * (n / nx)));
         }
-        let half = SPACING / 2;
-        let kinds = [
-            ((half, half), (0.5, 0.5)),
-            ((half, 0), (0.5, 0.0)),
-            ((0, half), (0.0, 0.5)),
-        ];
-        let mut k = 0;
-        for ((di, dj), at) in kinds {
-            let (across, up) = (nx - usize::from(di > 0), ny - usize::from(dj > 0));
-            for c in 0..up {
-                for a in 0..across {
-                    let (i, j) = grid::node_pixel(block, c * nx + a, nx, SPACING);
-                    push(&mut s, (i + di, j + dj));
-                    // A point on the grid's last row or column lies on the
-                    // far edge of the cell before it.
-                    let cell = (a.min(nx - 2), c.min(ny - 2));
-                    let at = (at.0 + (a - cell.0) as f32, at.1 + (c - cell.1) as f32);
-                    s.checks[k] = (cell, at);
-                    k += 1;
+        for ((di, dj), _) in KINDS {
+            let (da, dc) = (usize::from(di > 0), usize::from(dj > 0));
+            for c in 0..s.ny - dc {
+                for a in 0..nx - da {
+                    push(&mut s, (2 * a + da, 2 * c + dc));
                 }
             }
         }
         s
     }
 
-    /// The check points' cells and places in them, in order.
-    fn checks(&self) -> &[Place] {
-        &self.checks[..self.len - self.nodes]
+    /// The pixel sample `n` reads its sums from (samples past the block's
+    /// far edges read its last row or column).
+    fn pixel(&self, n: usize) -> (i32, i32) {
+        let ((a2, c2), _) = self.lattice(n);
+        let half = SPACING / 2;
+        let (i, j) = (
+            self.first.0 + a2 as i32 * half,
+            self.first.1 + c2 as i32 * half,
+        );
+        (i.min(self.last.0), j.min(self.last.1))
+    }
+
+    /// Sample `n` on the half-spacing lattice (across, up), and for a
+    /// check point its place in a grid cell.
+    fn lattice(&self, n: usize) -> ((usize, usize), Option<Place>) {
+        let (nx, ny) = (self.nx, self.ny);
+        if n < self.nodes {
+            return ((2 * (n % nx), 2 * (n / nx)), None);
+        }
+        let mut k = n - self.nodes;
+        for ((di, dj), at) in KINDS {
+            let (da, dc) = (usize::from(di > 0), usize::from(dj > 0));
+            let across = nx - da;
+            let count = across * (ny - dc);
+            if k < count {
+                let (a, c) = (k % across, k / across);
+                // A point on the grid's last row or column lies on the far
+                // edge of the cell before it.
+                let cell = (a.min(nx - 2), c.min(ny - 2));
+                let at = (at.0 + (a - cell.0) as f32, at.1 + (c - cell.1) as f32);
+                return ((2 * a + da, 2 * c + dc), Some((cell, at)));
+            }
+            k -= count;
+        }
+        unreachable!("sample {n} of {}", self.len)
+    }
+
+    /// The check points' places, in order.
+    fn checks(&self) -> impl Iterator<Item = Place> + '_ {
+        (self.nodes..self.len).filter_map(|n| self.lattice(n).1)
     }
 }
 
@@ -174,7 +210,8 @@ impl Lag {
     /// Notes what the block's pixels in `band` hold at `samples`, after
     /// they were written.
     pub fn look(&mut self, band: &Band, samples: &Samples) {
-        for (seen, &(i, j)) in self.seen.0.iter_mut().zip(&samples.pixels[..samples.len]) {
+        for (n, seen) in self.seen.0[..samples.len].iter_mut().enumerate() {
+            let (i, j) = samples.pixel(n);
             let (p, w) = band.at(i, j);
             *seen = [p[0], p[1], w];
         }
@@ -214,7 +251,7 @@ impl Lag {
             spacing: SPACING,
             sums: due.pending[..samples.nodes].to_vec(),
         };
-        for (owed, &(cell, at)) in due.owed.iter_mut().zip(samples.checks()) {
+        for (owed, (cell, at)) in due.owed.iter_mut().zip(samples.checks()) {
             let taken = grid.at(cell, at);
             for m in 0..3 {
                 owed[m] -= taken[m];
