@@ -265,8 +265,9 @@ impl Moved {
     }
 
     /// A band of the new map, holding the map before: the moved lines'
-    /// terms swapped in each block as [`Self::plan`] says, and the blocks
-    /// where some pixel's sums cannot take the swap evaluated afresh.
+    /// terms swapped in each block as [`Self::plan`] says, the pixels whose
+    /// sums cannot take the swap evaluated exactly, and a block with many
+    /// of them evaluated afresh.
     fn redo(&self, band: &mut Band, lags: &mut [Lag]) {
         let scale = band.setup.scale;
         let samples: Vec<Samples> = (0..lags.len())
@@ -298,8 +299,8 @@ impl Moved {
     /// Near the moved lines, before or after, their terms are swapped
     /// exactly: whether a fresh block would have put them among its near
     /// lines or its far grid changes nothing but how exactly they are
-    /// counted (see [`Self::shift`]), and there the swap's weight check is
-    /// what refuses a block. Far from them, as far as an adaptive
+    /// counted (see [`Self::shift`]), and there the swap's weight check
+    /// picks the pixels to evaluate exactly. Far from them, as far as an adaptive
     /// evaluation's far lines, the change is known from the block's grid
     /// and waits in its [`Lag`] until it matters.
     fn plan(&self, band: &Band, k: usize, lag: &mut Lag, samples: &Samples) -> Option<Plan> {
@@ -337,8 +338,10 @@ impl Moved {
     /// Swaps the moved lines' old terms for their new ones in every pixel
     /// of the band's blocks as `steps` say, row by row across the band (the
     /// map is read and written in the order it lies in memory, which keeps
-    /// the memory system streaming); a block where some pixel's sums could
-    /// not take it becomes [`Step::Fresh`], and from that row on is skipped.
+    /// the memory system streaming). The pixels whose sums could not take
+    /// it are evaluated exactly afterwards ([`Self::repair`]); a block
+    /// where they reach a quarter of its pixels becomes [`Step::Fresh`],
+    /// and from that row on is skipped.
     ///
     /// Exact terms leave each pixel's error what it was: the far field's
     /// interpolation error in the sums (checked when the block was made) is
