@@ -154,10 +154,10 @@ impl Lines {
     }
 
     /// At each point, `after`'s sums less these lines' (`[Σ w·Δx, Σ w·Δy,
-    /// Σ w]`), and these lines' `Σ w`, into four slices padded to whole
-    /// lanes (at least `xs.len()` rounded up to 8 long). Both sets share
-    /// one pass, so their dependency chains overlap.
-    pub fn change_to(&self, after: &Lines, xs: &[f32], ys: &[f32], out: [&mut [f32]; 4]) {
+    /// Σ w]`), into three slices padded to whole lanes (at least
+    /// `xs.len()` rounded up to 8 long). Both sets share one pass, so their
+    /// dependency chains overlap.
+    pub fn change_to(&self, after: &Lines, xs: &[f32], ys: &[f32], out: [&mut [f32]; 3]) {
         match self.exponent.unwrap_or(Exponent::One) {
             Exponent::Zero => self.change_with(|_| f32x8::ONE, after, xs, ys, out),
             Exponent::Half => self.change_with(|r| r.sqrt(), after, xs, ys, out),
@@ -177,7 +177,7 @@ impl Lines {
         after: &Lines,
         xs: &[f32],
         ys: &[f32],
-        [dx, dy, dw, old_w]: [&mut [f32]; 4],
+        [dx, dy, dw]: [&mut [f32]; 3],
     ) {
         let mut k = 0;
         while k < xs.len() {
@@ -196,7 +196,6 @@ impl Lines {
             dx[k..k + 8].copy_from_slice(&change.x.to_array());
             dy[k..k + 8].copy_from_slice(&change.y.to_array());
             dw[k..k + 8].copy_from_slice(&change.w.to_array());
-            old_w[k..k + 8].copy_from_slice(&old.w.to_array());
             k += take;
         }
     }

@@ -36,8 +36,8 @@ pub(super) fn map_window(
 ) -> WarpMap {
     let mut pos = vec![[0f32; 2]; window.area()];
     let setup = Setup::new(warp, window, scale, Some(tolerance));
-    let mut made = vec![false; setup.block_count()];
-    setup.each_band(&mut pos, None, &mut made, fill_band);
+    let mut blocks = vec![(); setup.block_count()];
+    setup.each_band(&mut pos, None, &mut blocks, fill_band);
     WarpMap::new(window, scale, pos)
 }
 
@@ -142,9 +142,9 @@ impl<'a> Setup<'a> {
 }
 
 /// Evaluates every block of `band` afresh ([`Block::fill`]).
-pub(super) fn fill_band(band: &mut Band, made: &mut [bool]) {
-    for (k, made) in made.iter_mut().enumerate() {
-        *made = band.block(k).fill();
+fn fill_band(band: &mut Band, blocks: &mut [()]) {
+    for k in 0..blocks.len() {
+        band.block(k).fill();
     }
 }
 
@@ -243,12 +243,11 @@ struct Sets {
 
 impl Block<'_> {
     /// Evaluates the block: near lines exactly, far ones from a grid when
-    /// that passes the checks, else all exactly. Whether the far field was
-    /// interpolated.
-    pub fn fill(&mut self) -> bool {
+    /// that passes the checks, else all exactly.
+    pub fn fill(&mut self) {
         if self.setup.tol.is_none() {
             self.exact();
-            return false;
+            return;
         }
         let (lo, hi) = corners(self.rect);
         let mut sets = std::mem::take(&mut self.scratch.sets);
@@ -264,7 +263,7 @@ impl Block<'_> {
         if sets.far_idx.is_empty() {
             self.scratch.sets = sets;
             self.exact();
-            return false;
+            return;
         }
         let all = &self.setup.warp.kernel;
         all.select_into(&sets.far_idx, &mut sets.far);
@@ -272,11 +271,9 @@ impl Block<'_> {
         let grid = self.far_grid(&sets.far);
         self.rows(&sets.near, Some(&grid));
         self.scratch.sets = sets;
-        if self.checks_pass() {
-            return true;
+        if !self.checks_pass() {
+            self.exact();
         }
-        self.exact();
-        false
     }
 
     /// Canonical position of the centre of pixel `(i, j)`.

@@ -327,7 +327,7 @@ impl Moved {
     /// The moved lines' change `[Δ Σ w·Δx, Δ Σ w·Δy, Δ Σ w]` at each
     /// sample.
     fn changes_at(&self, samples: &Samples) -> Vec<[f32; 3]> {
-        let mut change = [[0f32; lag::PADDED]; 4];
+        let mut change = [[0f32; lag::PADDED]; 3];
         let (xs, ys) = (&samples.xs[..samples.len], &samples.ys[..samples.len]);
         (self.old).change_to(&self.new, xs, ys, change.each_mut().map(|v| &mut v[..]));
         (0..samples.len)
@@ -358,7 +358,7 @@ impl Moved {
             .collect();
         let lanes = setup.block_columns(0).len().div_ceil(8) * 8;
         let mut ys = vec![0f32; lanes];
-        let mut change: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0f32; lanes]);
+        let mut change: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0f32; lanes]);
         let mut refused = vec![false; lanes];
         for j in band.y1..band.y2 {
             let y = scale.pixel_centre(window.x1, j).y as f32;
@@ -384,15 +384,14 @@ impl Moved {
                         let out = change.each_mut().map(|v| &mut v[..]);
                         (self.old).change_to(&self.new, xs, &ys[..n], out);
                         if let Some(p) = pending {
-                            for (m, c) in change[..3].iter_mut().enumerate() {
+                            for (m, c) in change.iter_mut().enumerate() {
                                 c[..n]
                                     .iter_mut()
                                     .enumerate()
                                     .for_each(|(i, c)| *c += p.at(m, i));
                             }
                         }
-                        let [dx, dy, dw, _] = change.each_ref().map(|v| &v[..]);
-                        RowChange::exact([dx, dy, dw])
+                        RowChange::exact(change.each_ref().map(|v| &v[..]))
                     }
                 };
                 let pixels = (&mut out[cols.clone()], &mut weights[cols.clone()]);
