@@ -259,3 +259,17 @@ fn a_map_handed_over_is_redone_as_a_copy_of_it_is() {
         assert_eq!(**copied.map(), **handed.map(), "step {step}");
     }
 }
+
+/// After 64 redos in a row the next map is made in full, so rounding
+/// kept from one redo to the next stays bounded.
+#[test]
+fn the_65th_map_of_a_drag_is_made_in_full() {
+    let (window, scale) = (RectI::new(0, 0, 160, 96), PixelScale::UNIT);
+    let mut pairs = spread_pairs(13, 8, 160.0, 96.0);
+    let mut kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+    for step in 1..=65u32 {
+        pairs = drag(&pairs, 0, v(0.25, 0.0));
+        kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map_from(window, scale, kept);
+        assert_eq!(kept.redos(), step % 65, "map {step}");
+    }
+}
