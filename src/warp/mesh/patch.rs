@@ -7,6 +7,7 @@
 
 mod grid;
 mod lanes;
+mod quads;
 
 use rayon::prelude::*;
 
@@ -26,6 +27,10 @@ const M: [[f64; 4]; 4] = [
 
 /// Rows of the map computed together, one per lane of `f64x4` ([`lanes`]).
 const LANES: usize = 4;
+/// Columns at which the Newton chains along a row of pixels start cold,
+/// fixed in the image so that any window of a map has the whole frame's
+/// bits (a multiple of every grid step: 2, 3 and 4).
+const RUN: i32 = 48;
 
 /// Newton stops when the located point is this close (canonical pixels).
 const TOLERANCE: f64 = 1e-7;
@@ -45,7 +50,7 @@ pub(super) struct Surface {
     /// Per cell: x then y coefficients, `c[i * 4 + j]` for `u^i v^j`.
     coef: Vec<[[f64; 16]; 2]>,
     /// The node quads, for finding a starting cell, and their bounds.
-    quads: Vec<[Vec2; 4]>,
+    quads: quads::Quads,
     bounds: (Vec2, Vec2),
 }
 
@@ -121,7 +126,7 @@ impl Surface {
             rows,
             cols,
             coef,
-            quads,
+            quads: quads::Quads::new(quads, lo, hi),
             bounds: (lo, hi),
         }
     }
@@ -185,6 +190,7 @@ impl Surface {
     /// The shortest side of any cell's node quad (canonical px).
     fn smallest_cell(&self) -> f64 {
         self.quads
+            .all()
             .iter()
             .flat_map(|q| (0..4).map(move |k| q[k].distance(q[(k + 1) % 4])))
             .fold(f64::INFINITY, f64::min)
@@ -233,22 +239,18 @@ impl Surface {
         None
     }
 
-    /// A starting point: the centre of the cell whose node quad holds `p`.
+    /// A starting point: where `p` lies in the bilinear quad of the
+    /// cell's nodes that holds it (the patch passes through those nodes,
+    /// so Newton starts a fraction of a cell off at most).
     pub(super) fn start(&self, p: Vec2) -> Option<(f64, f64)> {
         let (lo, hi) = self.bounds;
         if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
             return None;
         }
-        let inside = |q: &[Vec2; 4]| {
-            (0..4).all(|k| {
-                let (a, b) = (q[k], q[(k + 1) % 4]);
-                let (e, d) = (b - a, p - a);
-                e.x * d.y - e.y * d.x >= 0.0
-            })
-        };
-        let k = self.quads.iter().position(inside)?;
+        let k = self.quads.holding(p)?;
+        let (u, v) = quads::within(&self.quads.all()[k], p);
         let cells = self.cols - 1;
-        Some(((k % cells) as f64 + 0.5, (k / cells) as f64 + 0.5))
+        Some(((k % cells) as f64 + u, (k / cells) as f64 + v))
     }
 }
 
@@ -361,6 +363,36 @@ impl Trail {
 }
 
 impl MeshWarp {
+    /// Rows `j..` of the map (as many as `out` holds, up to [`LANES`]),
+    /// pixels `x1..`, into `out`: each row in runs that start Newton cold
+    /// at multiples of [`RUN`] in the image, solved from the start of
+    /// the first, so that any window has the bits of the whole frame.
+    fn map_band(&self, (x1, w): (i32, usize), j: i32, scale: PixelScale, out: &mut [[f32; 2]]) {
+        let rows = out.len() / w;
+        let x2 = x1 + w as i32;
+        let mut start = x1.div_euclid(RUN) * RUN;
+        let mut run = Vec::new();
+        while start < x2 {
+            let n = ((start + RUN).min(x2) - start) as usize;
+            run.clear();
+            run.resize(rows * n, [0f32; 2]);
+            if rows == LANES {
+                self.map_rows4(start, j, scale, &mut run);
+            } else {
+                for (r, row) in run.chunks_mut(n).enumerate() {
+                    self.map_row(start, j + r as i32, scale, row);
+                }
+            }
+            // The first run may start left of the window.
+            let skip = (x1 - start).max(0) as usize;
+            let at = (start + skip as i32 - x1) as usize;
+            for r in 0..rows {
+                out[r * w + at..][..n - skip].copy_from_slice(&run[r * n + skip..][..n - skip]);
+            }
+            start += RUN;
+        }
+    }
+
     /// Row `j` of the map, pixels `x1..`, into `out`.
     fn map_row(&self, x1: i32, j: i32, scale: PixelScale, out: &mut [[f32; 2]]) {
         let points = (0..out.len()).map(|k| scale.pixel_centre(x1 + k as i32, j));
@@ -422,13 +454,7 @@ impl Warp for MeshWarp {
                 .enumerate()
                 .for_each(|(band, out)| {
                     let j = window.y1 + (LANES * band) as i32;
-                    if out.len() == LANES * w {
-                        self.map_rows4(window.x1, j, scale, out);
-                    } else {
-                        for (row, out) in out.chunks_mut(w).enumerate() {
-                            self.map_row(window.x1, j + row as i32, scale, out);
-                        }
-                    }
+                    self.map_band((window.x1, w), j, scale, out);
                 });
         }
         WarpMap::new(window, scale, pos)
@@ -477,7 +503,7 @@ mod tests {
         let w = window.width();
         for j in window.y1..window.y2 {
             let mut row = vec![[0f32; 2]; w];
-            warp.map_row(window.x1, j, PixelScale::UNIT, &mut row);
+            warp.map_band((window.x1, w), j, PixelScale::UNIT, &mut row);
             let got = map.row(j).unwrap();
             for (i, (a, b)) in got.iter().zip(&row).enumerate() {
                 assert_eq!(
@@ -486,6 +512,46 @@ mod tests {
                     "pixel ({}, {j})",
                     window.x1 + i as i32
                 );
+            }
+        }
+    }
+
+    /// Tiles, chunks of rows and single scanlines of a map have the bits
+    /// of the whole frame's map there, on the grid and solved at every
+    /// pixel, at full and half scale: the grid and the Newton chains are
+    /// fixed in the image, not in the window.
+    #[test]
+    fn any_window_of_the_map_has_the_whole_frames_bits() {
+        let frame = RectI::new(-12, -7, 251, 170);
+        for (exact, scale) in [(false, 1.0), (false, 0.5), (true, 1.0), (true, 0.5)] {
+            let warp = match exact {
+                true => curved(),
+                false => curved().within(MeshWarp::TOLERANCE),
+            };
+            let scale = PixelScale::new(scale, scale, 1.0);
+            let frame = RectI::new(frame.x1, frame.y1, frame.x2, frame.y2);
+            let whole = warp.map_window(frame, scale);
+            let windows = [
+                RectI::new(0, 0, 64, 64),
+                RectI::new(37, 21, 101, 83),
+                RectI::new(-12, 55, 251, 56),
+                RectI::new(130, -7, 131, 170),
+                RectI::new(61, 150, 250, 169),
+            ];
+            for window in windows {
+                let part = warp.map_window(window, scale);
+                for j in window.y1..window.y2 {
+                    let (got, want) = (part.row(j).unwrap(), whole.row(j).unwrap());
+                    let want = &want[(window.x1 - frame.x1) as usize..][..got.len()];
+                    for (i, (a, b)) in got.iter().zip(want).enumerate() {
+                        assert_eq!(
+                            a.map(f32::to_bits),
+                            b.map(f32::to_bits),
+                            "exact {exact}, scale {scale:?}, {window:?}: pixel ({}, {j})",
+                            window.x1 + i as i32
+                        );
+                    }
+                }
             }
         }
     }

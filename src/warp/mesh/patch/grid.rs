@@ -9,11 +9,16 @@
 
 use rayon::prelude::*;
 
-use super::{MeshWarp, Params, LANES};
+use super::{MeshWarp, Params, LANES, RUN};
 use crate::geom::{PixelScale, RectI, Vec2};
 
 /// Most pixels between grid nodes.
 const GRID: usize = 4;
+/// Columns at which the Newton chains along a row of nodes start cold
+/// ([`RUN`] for rows of pixels): a cold start costs a few Newton steps
+/// more, a run's first nodes miss the lanes, and nodes left of a window
+/// cost a sixteenth of pixels.
+const NODE_RUN: i32 = 4 * RUN;
 /// Least nodes along a side of the mesh's smallest cell, so that curvature
 /// within a cell shows in the nodes' differences.
 const NODES_PER_CELL: f64 = 2.0;
@@ -102,26 +107,57 @@ impl MeshWarp {
         tolerance: f64,
         pos: &mut [[f32; 2]],
     ) -> Option<(usize, usize)> {
-        let (w, h) = (window.width(), window.height());
         let smallest = self.to.smallest_cell() * scale.x.min(scale.y);
         let step = GRID.min((smallest / NODES_PER_CELL) as usize);
-        if step < 2 || w < 2 || h < 2 {
+        if step < 2 {
             return None;
         }
-        let px = Pixels { window, scale };
+        // The grid is fixed in the image, so any window of the map (a tile,
+        // a chunk) has the bits the whole frame has there: its knots are
+        // multiples of `step`, every pixel of the window lies inside a cell
+        // (never on a last cell's closing knot), and each node's bends see
+        // its neighbours on both sides.
+        let s = step as i32;
+        debug_assert_eq!(RUN % s, 0);
+        let first = |a: i32| a.div_euclid(s) * s;
+        let (x1, y1) = (first(window.x1), first(window.y1));
+        let (x2, y2) = (first(window.x2 - 1) + s, first(window.y2 - 1) + s);
+        let region = RectI::new(x1, y1, x2 + 1, y2 + 1);
+        let (rw, rh) = (region.width(), region.height());
+        let px = Pixels {
+            window: region,
+            scale,
+        };
         // Positions are canonical: a render pixel spans 1 / scale of them.
         let tol = tolerance * SAFETY / scale.x.max(scale.y);
-        let (xs, ys) = (knots(w, step), knots(h, step));
-        let nodes = self.nodes(&px, &xs, &ys);
-        // Bands of cells, each with its rows of `pos`.
+        let (xs, ys) = (knots(rw, step), knots(rh, step));
+        let nodes = self.nodes_around(region, step, scale);
+        // Bands of cells, each with the window's rows it holds.
+        let (dx, dy) = (
+            (window.x1 - region.x1) as usize,
+            (window.y1 - region.y1) as usize,
+        );
+        let w = window.width();
+        let columns = dx..dx + w;
         let mut bands = Vec::with_capacity(ys.len() - 1);
         let mut rest = pos;
         for b in 0..ys.len() - 1 {
-            let (band, tail) = rest.split_at_mut(span(&ys, b).len() * w);
-            bands.push((b, band));
+            let rows = clip(&span(&ys, b), &(dy..dy + window.height()));
+            if rows.is_empty() {
+                continue;
+            }
+            let (band, tail) = rest.split_at_mut(rows.len() * w);
+            bands.push((
+                b,
+                Out {
+                    data: band,
+                    rows,
+                    columns: columns.clone(),
+                },
+            ));
             rest = tail;
         }
-        let solved = bands.into_par_iter().map(|(b, band)| {
+        let solved = bands.into_par_iter().map(|(b, mut out)| {
             let cells: Vec<Cell> = (0..xs.len() - 1)
                 .map(|c| Cell {
                     columns: span(&xs, c),
@@ -134,15 +170,43 @@ impl MeshWarp {
                         &nodes[b + 1][c + 1],
                     ],
                 })
+                .filter(|cell| !clip(&cell.columns, &out.columns).is_empty())
                 .collect();
             let fills: Vec<Fill> = cells.iter().map(|c| self.fill(&px, c, tol)).collect();
-            fill_rows(&px, &cells, &fills, [&nodes[b], &nodes[b + 1]], band, w);
+            fill_rows(&px, &cells, &fills, &mut out);
             let solve = cells.iter().zip(&fills).filter(|(_, f)| **f == Fill::Solve);
-            solve
-                .map(|(cell, _)| self.solve_cell(&px, cell, band, w))
-                .count()
+            let solved = solve.map(|(cell, _)| self.solve_cell(&px, cell, &mut out));
+            (solved.count(), cells.len())
         });
-        Some((solved.sum(), (xs.len() - 1) * (ys.len() - 1)))
+        let counts = solved.reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        Some(counts)
+    }
+
+    /// The nodes of the grid of `step` over `region` (whose corners lie on
+    /// it), row by row, with their second differences: solved over a grid
+    /// one node wider each side, and further left to where the Newton
+    /// chains along its rows start (at multiples of [`NODE_RUN`] in the image),
+    /// so that every node in `region` comes out the same whatever the
+    /// region.
+    fn nodes_around(&self, region: RectI, step: usize, scale: PixelScale) -> Vec<Vec<Node>> {
+        let s = step as i32;
+        let x1 = (region.x1 - s).div_euclid(NODE_RUN) * NODE_RUN;
+        let around = RectI::new(x1, region.y1 - s, region.x2 + s, region.y2 + s);
+        let px = Pixels {
+            window: around,
+            scale,
+        };
+        let (xs, ys) = (knots(around.width(), step), knots(around.height(), step));
+        let skip = ((region.x1 - x1) / s) as usize;
+        let across = (region.width() - 1) / step + 1;
+        let mut nodes = self.nodes(&px, &xs, &ys);
+        nodes.pop();
+        nodes.remove(0);
+        for row in &mut nodes {
+            row.drain(..skip);
+            row.truncate(across);
+        }
+        nodes
     }
 
     /// The grid's nodes, row by row, with their second differences.
@@ -183,34 +247,34 @@ impl MeshWarp {
     }
 
     /// The nodes of pixel rows `js`, each starting Newton from those before
-    /// it in its row: four rows in the lanes, fewer one by one.
+    /// it in its row's run: four rows in the lanes, fewer one by one.
     fn node_rows(&self, px: &Pixels, xs: &[usize], js: &[usize]) -> Vec<Vec<Node>> {
         let node = |q: Vec2, at| Node {
             q,
             at,
             bend: [f64::INFINITY; 2],
         };
-        if let Ok(js) = <[usize; LANES]>::try_from(js) {
-            let mut rows: Vec<Vec<Node>> =
-                (0..LANES).map(|_| Vec::with_capacity(xs.len())).collect();
-            let ys = js.map(|j| px.centre(0, j).y);
-            let x = xs.iter().map(|&i| px.centre(i, 0).x);
-            self.rows4(x, ys, [None; LANES], |_, q, found| {
-                let (qx, qy) = (q.x.to_array(), q.y.to_array());
-                for (l, row) in rows.iter_mut().enumerate() {
-                    row.push(node(Vec2::new(qx[l], qy[l]), found.get(l)));
-                }
-            });
-            return rows;
-        }
-        js.iter()
-            .map(|&j| {
-                let mut row = Vec::with_capacity(xs.len());
+        let mut rows: Vec<Vec<Node>> = js.iter().map(|_| Vec::with_capacity(xs.len())).collect();
+        // Each run of the row starts Newton cold.
+        let run = |i: &usize| (px.window.x1 + *i as i32).div_euclid(NODE_RUN);
+        for xs in xs.chunk_by(|a, b| run(a) == run(b)) {
+            if let Ok(js) = <[usize; LANES]>::try_from(js) {
+                let ys = js.map(|j| px.centre(0, j).y);
+                let x = xs.iter().map(|&i| px.centre(i, 0).x);
+                self.rows4(x, ys, [None; LANES], |_, q, found| {
+                    let (qx, qy) = (q.x.to_array(), q.y.to_array());
+                    for (l, row) in rows.iter_mut().enumerate() {
+                        row.push(node(Vec2::new(qx[l], qy[l]), found.get(l)));
+                    }
+                });
+                continue;
+            }
+            for (row, &j) in rows.iter_mut().zip(js) {
                 let points = xs.iter().map(|&i| px.centre(i, j));
                 self.locate_run(points, None, |_, q, at| row.push(node(q, at)));
-                row
-            })
-            .collect()
+            }
+        }
+        rows
     }
 
     /// How a cell is filled: bilinearly where its nodes bound the error
@@ -229,27 +293,25 @@ impl MeshWarp {
 
     /// Newton at every pixel of `cell`, into `band` (its band's rows, `w`
     /// pixels each).
-    fn solve_cell(&self, px: &Pixels, cell: &Cell, band: &mut [[f32; 2]], w: usize) {
-        let j0 = cell.rows.start;
+    fn solve_cell(&self, px: &Pixels, cell: &Cell, out: &mut Out) {
+        let i0 = cell.columns.start;
         if cell.rows.len() == LANES {
             // Four rows in the lanes, each from its left nodes' parameters.
-            let rows: [usize; LANES] = std::array::from_fn(|l| j0 + l);
+            let rows: [usize; LANES] = std::array::from_fn(|l| cell.rows.start + l);
             let seed = rows.map(|j| cell.seed(j));
             let ys = rows.map(|j| px.centre(0, j).y);
             let xs = cell.columns.clone().map(|i| px.centre(i, 0).x);
-            let i0 = cell.columns.start;
             self.rows4(xs, ys, seed, |k, q, _| {
                 let (qx, qy) = (q.x.to_array(), q.y.to_array());
                 for l in 0..LANES {
-                    band[(rows[l] - j0) * w + i0 + k] = [qx[l] as f32, qy[l] as f32];
+                    out.put(i0 + k, rows[l], Vec2::new(qx[l], qy[l]));
                 }
             });
             return;
         }
         for j in cell.rows.clone() {
-            let row = &mut band[(j - j0) * w..][cell.columns.clone()];
             let points = cell.columns.clone().map(|i| px.centre(i, j));
-            let put = |k: usize, q: Vec2, _| row[k] = [q.x as f32, q.y as f32];
+            let put = |k: usize, q: Vec2, _| out.put(i0 + k, j, q);
             self.locate_run(points, cell.seed(j), put);
         }
     }
@@ -306,46 +368,73 @@ enum Fill {
 
 /// The bilinear and identity cells of a band, pixel row by pixel row: each
 /// row's values at the node columns are interpolated once between the
-/// band's two node rows (`nodes`), then along the row.
-fn fill_rows(
-    px: &Pixels,
-    cells: &[Cell],
-    fills: &[Fill],
-    nodes: [&[Node]; 2],
-    band: &mut [[f32; 2]],
-    w: usize,
-) {
+/// band's two node rows (its cells' corners), then along the row.
+fn fill_rows(px: &Pixels, cells: &[Cell], fills: &[Fill], out: &mut Out) {
     let Some(first) = cells.first() else {
         return;
     };
-    let (rows, (y0, y1)) = (first.rows.clone(), first.knots[1]);
+    let (y0, y1) = first.knots[1];
     let mix = |p: Vec2, q: Vec2, f: f64| p * (1.0 - f) + q * f;
-    for j in rows.clone() {
-        let row = &mut band[(j - rows.start) * w..][..w];
+    let columns = out.columns.clone();
+    for j in out.rows.clone() {
         let fy = (j - y0) as f64 / (y1 - y0) as f64;
-        let at = |c: usize| mix(nodes[0][c].q, nodes[1][c].q, fy);
-        let mut left = at(0);
-        for (c, (cell, fill)) in cells.iter().zip(fills).enumerate() {
-            let right = at(c + 1);
-            let out = &mut row[cell.columns.clone()];
+        let at = |n: [&Node; 2]| mix(n[0].q, n[1].q, fy);
+        let row = out.row(j);
+        for (cell, fill) in cells.iter().zip(fills) {
+            let [bl, br, tl, tr] = cell.corners;
+            let (x0, x1) = cell.knots[0];
+            let part = clip(&cell.columns, &columns);
+            let pixels = part
+                .clone()
+                .zip(&mut row[part.start - columns.start..][..part.len()]);
             match fill {
                 Fill::Bilinear => {
-                    let (x0, x1) = cell.knots[0];
+                    let (left, right) = (at([bl, tl]), at([br, tr]));
                     let step = (right - left) * (1.0 / (x1 - x0) as f64);
-                    for (k, o) in out.iter_mut().enumerate() {
-                        let q = left + step * k as f64;
+                    for (i, o) in pixels {
+                        let q = left + step * (i - x0) as f64;
                         *o = [q.x as f32, q.y as f32];
                     }
                 }
                 Fill::Identity => {
-                    for (i, o) in cell.columns.clone().zip(out) {
+                    for (i, o) in pixels {
                         let p = px.centre(i, j);
                         *o = [p.x as f32, p.y as f32];
                     }
                 }
                 Fill::Solve => {}
             }
-            left = right;
+        }
+    }
+}
+
+/// `a` within `b`.
+fn clip(a: &std::ops::Range<usize>, b: &std::ops::Range<usize>) -> std::ops::Range<usize> {
+    a.start.max(b.start)..a.end.min(b.end).max(a.start.max(b.start))
+}
+
+/// The window's rows of one band of the map: pixels (in the grid's
+/// region) `columns` of each of `rows`.
+struct Out<'a> {
+    data: &'a mut [[f32; 2]],
+    rows: std::ops::Range<usize>,
+    columns: std::ops::Range<usize>,
+}
+
+impl Out<'_> {
+    /// Pixel row `j` of the region, the window's part of it.
+    fn row(&mut self, j: usize) -> &mut [[f32; 2]] {
+        let w = self.columns.len();
+        &mut self.data[(j - self.rows.start) * w..][..w]
+    }
+
+    /// The map at pixel `(i, j)` of the region, if the window holds it.
+    #[inline]
+    fn put(&mut self, i: usize, j: usize, q: Vec2) {
+        if self.rows.contains(&j) && self.columns.contains(&i) {
+            let w = self.columns.len();
+            self.data[(j - self.rows.start) * w + i - self.columns.start] =
+                [q.x as f32, q.y as f32];
         }
     }
 }
