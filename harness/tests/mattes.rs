@@ -338,13 +338,18 @@ fn stmap_det(st: &Image, i: i32, j: i32) -> f64 {
     (xi * yj - yi * xj) * (W * H) as f64
 }
 
-/// Renders `inst`'s ST maps and folds view and checks that folds mark
-/// exactly the pixels where a map's numeric Jacobian is not positive;
-/// returns how many were folded and how many not.
-fn check_folds(inst: &host::Instance<'_>, stmaps: &[&str], picture: &str) -> (usize, usize) {
+/// Renders `inst`'s ST maps and folds view at `time` and checks that
+/// folds mark exactly the pixels where a map's numeric Jacobian is not
+/// positive; returns how many were folded and how many not.
+fn check_folds(
+    inst: &host::Instance<'_>,
+    time: f64,
+    stmaps: &[&str],
+    picture: &str,
+) -> (usize, usize) {
     let view = |v: &str| {
         inst.set_choice("view", v).unwrap();
-        inst.render(1.0, spec("OfxBitDepthFloat"))
+        inst.render(time, spec("OfxBitDepthFloat"))
             .unwrap()
             .to_image()
     };
@@ -398,11 +403,65 @@ fn the_folds_view_marks_where_a_numeric_jacobian_turns_over() {
         swap_lines(inst);
         inst.set_choice("evaluation", "exact").unwrap();
         inst.set_double("progress", &[t], None).unwrap();
-        let (folded, flat) = check_folds(inst, stmaps, picture);
+        let (folded, flat) = check_folds(inst, 1.0, stmaps, picture);
         assert!(
             folded > 20 && flat > 20,
             "{picture} at {t}: {folded} folded, {flat} not"
         );
+    }
+}
+
+/// A keyed grid (as Track Forward writes one: a key a frame) whose cells
+/// are all convex, but whose B node is dragged up against its neighbour
+/// at frame 10: the Catmull-Rom surface overshoots between them and the
+/// map folds. The folds view marks exactly where, at the key and between
+/// keys (frame 9), with both evaluations of the mesh; at frame 0 (A = B)
+/// nothing folds.
+#[test]
+fn the_folds_view_marks_the_folds_a_keyed_grid_still_has() {
+    let (a, b) = (plate(0.0), plate(2.0));
+    let morph = node(
+        "net.morphfx.Morph",
+        "OfxImageEffectContextGeneral",
+        "OfxBitDepthFloat",
+        &a,
+        &b,
+    );
+    morph.set_int("line_count", 0).unwrap();
+    morph.set_double("progress", &[0.7], None).unwrap();
+    let (w, h) = (W as f64, H as f64);
+    let grid = |middle: [f64; 2]| -> String {
+        let mut nodes = Vec::new();
+        for y in [0.0, h / 2.0, h] {
+            for (c, x) in [0.0, 21.0, 42.0, w].into_iter().enumerate() {
+                let p = if y == h / 2.0 && c == 1 {
+                    middle
+                } else {
+                    [x, y]
+                };
+                nodes.push(format!("[{}, {}]", p[0], p[1]));
+            }
+        }
+        format!("[{}]", nodes.join(", "))
+    };
+    let even = grid([21.0, h / 2.0]);
+    let dragged = grid([40.0, h / 2.0]);
+    for pass in ["one-pass", "two-pass"] {
+        let scene = format!(
+            r#"{{"method": "mesh", "mesh": {{"rows": 3, "cols": 4, "pass": "{pass}",
+                "keyframes": [{{"frame": 0, "a": {even}, "b": {even}}},
+                              {{"frame": 10, "a": {even}, "b": {dragged}}}]}}}}"#
+        );
+        morph.set_string("scene_text", &scene).unwrap();
+        for frame in [10.0, 9.0] {
+            let (folded, flat) = check_folds(&morph, frame, &["stmap-a", "stmap-b"], "morph");
+            assert!(
+                folded > 10 && flat > 1000,
+                "{pass} at frame {frame}: {folded} folded, {flat} not"
+            );
+        }
+        let (folded, _) = check_folds(&morph, 0.0, &["stmap-a", "stmap-b"], "morph");
+        assert_eq!(folded, 0, "{pass}: the even grid at frame 0 folds nowhere");
     }
 }
 

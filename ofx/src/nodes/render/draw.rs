@@ -41,8 +41,8 @@ impl Job<'_> {
         b: Option<&Sampler<'_, S>>,
         rows: RowsMut<'_, D>,
     ) {
-        if let Some(pair) = self.meshes {
-            return self.draw_two_pass(pair, a, b, rows);
+        if let (Some(pair), false) = (self.meshes, self.view == View::Folds) {
+            return self.draw_two_pass(self.view, pair, a, b, rows);
         }
         let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
         match (self.view, b) {
@@ -66,7 +66,12 @@ impl Job<'_> {
             }
             (View::Folds, _) => {
                 let mut morph = Image::new(rows.bounds, 4);
-                self.picture(View::Morph, a, b, morph.view_mut().rows());
+                match self.meshes {
+                    Some(pair) => {
+                        self.draw_two_pass(View::Morph, pair, a, b, morph.view_mut().rows())
+                    }
+                    None => self.picture(View::Morph, a, b, morph.view_mut().rows()),
+                }
                 let maps: Vec<&WarpMap> = [ma, mb].into_iter().flatten().collect();
                 views::folds(&morph, &maps, rows)
             }
@@ -124,6 +129,7 @@ impl Job<'_> {
     /// move is copied, not filtered.
     fn draw_two_pass<S: Sample, D: Sample>(
         &self,
+        view: View,
         pair: &MeshPair,
         a: &Sampler<'_, S>,
         b: Option<&Sampler<'_, S>>,
@@ -146,7 +152,7 @@ impl Job<'_> {
                 p
             })
         };
-        let used = match (self.view, b) {
+        let used = match (view, b) {
             (View::Morph, Some(b)) => {
                 let (pa, pb) = (
                     (self.t < 1.0).then(|| plane(Side::A, a)).flatten(),

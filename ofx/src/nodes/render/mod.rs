@@ -456,6 +456,9 @@ fn prepare<'r>(
             .is_uniform_at(inputs.t);
     // The two-pass mesh warp makes pixels, not maps; weights need maps.
     let by_map = !(two_pass && picture) || weighted;
+    // The folds view measures the maps but shows the morph as the Morph
+    // view draws it.
+    let by_two_pass = two_pass && (picture || view == View::Folds) && !weighted;
     // Folds are measured by central differences: one pixel more each side.
     let w = request.window;
     let window = match view {
@@ -492,11 +495,7 @@ fn prepare<'r>(
         features: &inputs.features,
         map_a,
         map_b,
-        meshes: if by_map {
-            None
-        } else {
-            inputs.warp.meshes.as_ref()
-        },
+        meshes: inputs.warp.meshes.as_ref().filter(|_| by_two_pass),
         planes: &instance.planes,
         premultiply: premultiply(&request.sources),
         scale: request.out_scale,
