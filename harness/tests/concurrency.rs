@@ -11,12 +11,11 @@ use std::time::Duration;
 
 mod common;
 
-use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx::testing::Lcg;
-use morphfx_harness::host::{Frame, Instance, OutputSpec};
+use morphfx_harness::host::{Instance, OutputSpec};
 
-use common::{bundle, Still};
+use common::bundle;
 
 const W: usize = 64;
 const H: usize = 48;
@@ -33,17 +32,7 @@ fn instance() -> Instance<'static> {
     let inst = bundle()
         .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
         .unwrap();
-    for (clip, seed) in [("SourceA", 0.0f32), ("SourceB", 1.9)] {
-        let img = Image::from_fn(RectI::from_size(W, H), 4, |i, j, c| {
-            if c == 3 {
-                1.0
-            } else {
-                0.5 + 0.4 * (i as f32 * 0.41 + j as f32 * 0.27 + seed + c as f32).sin()
-            }
-        });
-        let f = Arc::new(Frame::from_image(&img, "OfxBitDepthFloat", false));
-        inst.connect(clip, Arc::new(Still(f))).unwrap();
-    }
+    common::connect_textured(&inst, &[("SourceA", 0.0), ("SourceB", 1.9)], (W, H));
     inst.set_project(W as f64, H as f64);
     inst.set_int("line_count", 1).unwrap();
     inst

@@ -377,16 +377,22 @@ fn check_folds(
     (folded, flat)
 }
 
-#[test]
-fn the_folds_view_marks_where_a_numeric_jacobian_turns_over() {
+/// A float Morph node on two textured plates.
+fn float_morph() -> host::Instance<'static> {
     let (a, b) = (plate(0.0), plate(2.0));
-    let morph = node(
+    node(
         "net.morphfx.Morph",
         "OfxImageEffectContextGeneral",
         "OfxBitDepthFloat",
         &a,
         &b,
-    );
+    )
+}
+
+#[test]
+fn the_folds_view_marks_where_a_numeric_jacobian_turns_over() {
+    let (a, b) = (plate(0.0), plate(2.0));
+    let morph = float_morph();
     let warp = node(
         "net.morphfx.Warp",
         "OfxImageEffectContextFilter",
@@ -419,14 +425,7 @@ fn the_folds_view_marks_where_a_numeric_jacobian_turns_over() {
 /// nothing folds.
 #[test]
 fn the_folds_view_marks_the_folds_a_keyed_grid_still_has() {
-    let (a, b) = (plate(0.0), plate(2.0));
-    let morph = node(
-        "net.morphfx.Morph",
-        "OfxImageEffectContextGeneral",
-        "OfxBitDepthFloat",
-        &a,
-        &b,
-    );
+    let morph = float_morph();
     morph.set_int("line_count", 0).unwrap();
     morph.set_double("progress", &[0.7], None).unwrap();
     let (w, h) = (W as f64, H as f64);

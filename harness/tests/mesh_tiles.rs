@@ -4,15 +4,11 @@
 //! the one-pass map's grid was fixed in the image, 8 tiles of its ST map
 //! differed from the whole frame in 1 362 samples.)
 
-use std::sync::Arc;
-
 mod common;
 
-use morphfx::geom::RectI;
-use morphfx::image::Image;
-use morphfx_harness::host::{Frame, OutputSpec};
+use morphfx_harness::host::OutputSpec;
 
-use common::{bundle, Still};
+use common::bundle;
 
 const W: usize = 96;
 const H: usize = 64;
@@ -46,17 +42,7 @@ fn a_mesh_rendered_in_tiles_has_the_whole_frames_bits() {
     let inst = bundle()
         .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
         .unwrap();
-    for (clip, seed) in [("SourceA", 0.0f32), ("SourceB", 1.9)] {
-        let img = Image::from_fn(RectI::from_size(W, H), 4, |i, j, c| {
-            if c == 3 {
-                1.0
-            } else {
-                0.5 + 0.4 * (i as f32 * 0.41 + j as f32 * 0.27 + seed + c as f32).sin()
-            }
-        });
-        let f = Arc::new(Frame::from_image(&img, "OfxBitDepthFloat", false));
-        inst.connect(clip, Arc::new(Still(f))).unwrap();
-    }
+    common::connect_textured(&inst, &[("SourceA", 0.0), ("SourceB", 1.9)], (W, H));
     inst.set_project(W as f64, H as f64);
     inst.set_int("line_count", 0).unwrap();
     inst.set_double("progress", &[0.4], None).unwrap();

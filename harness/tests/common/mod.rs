@@ -190,6 +190,29 @@ impl morphfx_harness::host::FrameSource for Still {
     }
 }
 
+/// Connects to each `(clip, seed)` of `clips` a still `w × h` float RGBA
+/// plate of sine texture (opaque, different for each seed).
+#[allow(dead_code)] // not every test file connects clips
+pub fn connect_textured(
+    inst: &morphfx_harness::host::Instance<'_>,
+    clips: &[(&str, f32)],
+    (w, h): (usize, usize),
+) {
+    for &(clip, seed) in clips {
+        let img =
+            morphfx::image::Image::from_fn(morphfx::geom::RectI::from_size(w, h), 4, |i, j, c| {
+                if c == 3 {
+                    1.0
+                } else {
+                    0.5 + 0.4 * (i as f32 * 0.41 + j as f32 * 0.27 + seed + c as f32).sin()
+                }
+            });
+        let f = morphfx_harness::host::Frame::from_image(&img, "OfxBitDepthFloat", false);
+        inst.connect(clip, std::sync::Arc::new(Still(std::sync::Arc::new(f))))
+            .unwrap();
+    }
+}
+
 /// A shot's pyramids held in memory, as the tracker asks for them.
 #[allow(dead_code)] // the tracking tests only
 pub struct InMemory(pub Vec<std::sync::Arc<morphfx::track::Pyramid>>);
