@@ -41,7 +41,8 @@ impl Job<'_> {
         b: Option<&Sampler<'_, S>>,
         rows: RowsMut<'_, D>,
     ) {
-        if let (Some(pair), false) = (self.meshes, self.view == View::Folds) {
+        // The folds view draws its picture below, over the maps' measure.
+        if let Some(pair) = self.meshes.filter(|_| self.view != View::Folds) {
             return self.draw_two_pass(self.view, pair, a, b, rows);
         }
         let (ma, mb) = (self.map_a.as_deref(), self.map_b.as_deref());
