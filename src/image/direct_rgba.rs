@@ -22,7 +22,9 @@
 //! the same order); bicubic ones sum the same sixteen products in another
 //! order (within a few float ulps). Positions it does not take (taps
 //! outside the image, on or near a pixel centre, NaN) go to the caller's
-//! one-pixel fallback.
+//! one-pixel fallback. A row's last one to three pixels go as a group of
+//! four too (the last position repeated), so a row split anywhere (a
+//! host's tile) gives every pixel the same bits as the whole row.
 
 use wide::{f32x8, i32x8};
 
@@ -291,6 +293,16 @@ pub(crate) fn row<T: Sample>(
     slow: impl Fn(usize, &mut [f32; 4]),
 ) {
     assert_eq!(positions.len(), out.len(), "one position per pixel");
+    // Pixels `first..` of a located group, one by one.
+    let each = |l: &Located, first: usize, outs: &mut [[f32; 4]]| {
+        for (k, o) in outs.iter_mut().enumerate() {
+            if (l.fast >> (2 * k)) & 3 == 3 {
+                *o = taps.pixel(l, k);
+            } else {
+                slow(first + k, o);
+            }
+        }
+    };
     let four = groups(positions);
     for (g, (p, outs)) in four.iter().zip(out.chunks_exact_mut(4)).enumerate() {
         if let Some(ahead) = four.get(g + AHEAD) {
@@ -303,17 +315,28 @@ pub(crate) fn row<T: Sample>(
             }
             continue;
         }
-        for (k, o) in outs.iter_mut().enumerate() {
-            if (l.fast >> (2 * k)) & 3 == 3 {
-                *o = taps.pixel(&l, k);
-            } else {
-                slow(4 * g + k, o);
-            }
-        }
+        each(&l, 4 * g, outs);
     }
-    for (n, o) in out.iter_mut().enumerate().skip(four.len() * 4) {
-        slow(n, o);
+    let done = four.len() * 4;
+    if done < out.len() {
+        each(
+            &taps.locate(&padded(&positions[done..])),
+            done,
+            &mut out[done..],
+        );
     }
+}
+
+/// A row's last one to three positions as a group of four, the last
+/// repeated: they take the same path as pixels inside a group, so a row
+/// split anywhere (a host's tile) gives every pixel the same bits.
+fn padded(rest: &[[f32; 2]]) -> [f32; 8] {
+    let last = rest[rest.len() - 1];
+    let mut group = [0f32; 8];
+    for (k, xy) in group.chunks_exact_mut(2).enumerate() {
+        xy.copy_from_slice(rest.get(k).unwrap_or(&last));
+    }
+    group
 }
 
 /// `out = wa · A + wb · B`, A sampled at `pa` and B at `pb`, both sources of
@@ -329,6 +352,20 @@ pub(crate) fn blend_row<S: Sample>(
         "one position per pixel and source"
     );
     let blend = |va: [f32; 4], vb: [f32; 4]| std::array::from_fn(|c| wb.mul_add(vb[c], wa * va[c]));
+    // Pixels `first..` of a located group of each source, one by one.
+    let each = |(la, lb): (&Located, &Located), first: usize, outs: &mut [[f32; 4]]| {
+        for (k, o) in outs.iter_mut().enumerate() {
+            let (fast_a, fast_b) = ((la.fast >> (2 * k)) & 3 == 3, (lb.fast >> (2 * k)) & 3 == 3);
+            *o = if fast_a && fast_b {
+                blend(a.pixel(la, k), b.pixel(lb, k))
+            } else {
+                let n = first + k;
+                let va = if fast_a { a.pixel(la, k) } else { slow_a(n) };
+                let vb = if fast_b { b.pixel(lb, k) } else { slow_b(n) };
+                blend(va, vb)
+            };
+        }
+    };
     let (four_a, four_b) = (groups(pa), groups(pb));
     let pixels = out.chunks_exact_mut(4);
     for (g, ((qa, qb), outs)) in four_a.iter().zip(four_b).zip(pixels).enumerate() {
@@ -347,19 +384,14 @@ pub(crate) fn blend_row<S: Sample>(
             }
             continue;
         }
-        for (k, o) in outs.iter_mut().enumerate() {
-            let (fast_a, fast_b) = ((la.fast >> (2 * k)) & 3 == 3, (lb.fast >> (2 * k)) & 3 == 3);
-            *o = if fast_a && fast_b {
-                blend(a.pixel(&la, k), b.pixel(&lb, k))
-            } else {
-                let n = 4 * g + k;
-                let va = if fast_a { a.pixel(&la, k) } else { slow_a(n) };
-                let vb = if fast_b { b.pixel(&lb, k) } else { slow_b(n) };
-                blend(va, vb)
-            };
-        }
+        each((&la, &lb), 4 * g, outs);
     }
-    for (n, o) in out.iter_mut().enumerate().skip(four_a.len() * 4) {
-        *o = blend(slow_a(n), slow_b(n));
+    let done = four_a.len() * 4;
+    if done < out.len() {
+        let (la, lb) = (
+            a.locate(&padded(&pa[done..])),
+            b.locate(&padded(&pb[done..])),
+        );
+        each((&la, &lb), done, &mut out[done..]);
     }
 }
