@@ -2,7 +2,8 @@
 // the OpenFX reference host library, then, for each node and each context
 // it must support, creates an instance, checks what the spec mandates in
 // that context, asks for identity where the answer is known, and renders
-// every warp method at render scale 1 and 0.5 in float and 8-bit, and
+// every warp method at render scale 1 and 0.5 in float and 8-bit (in
+// float also in four tiles, each held to the whole frame's bits), and
 // drives each node's overlay (draw, a drag that moves a line, shapes, a
 // grid made with Reset Grid and a node of it dragged; drawn in
 // an offscreen OpenGL context too, where Mesa's EGL is there). Exit
@@ -11,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -143,8 +145,11 @@ struct Render {
 /// One frame as a host renders it: region of definition, identity,
 /// begin, regions of interest, render, end. Then the output is read back.
 /// `interactive`: a viewer's render while the instance is manipulated
-/// (not sequential); otherwise one frame of a sequential render.
-Render render(Effect &fx, OfxPointD scale, const Where &w, bool interactive = false) {
+/// (not sequential); otherwise one frame of a sequential render. `tile`:
+/// render only that window of the frame, as a host that renders in tiles
+/// does (a tile may rightly be an identity; that is not asked).
+Render render(Effect &fx, OfxPointD scale, const Where &w, bool interactive = false,
+              const OfxRectI *tile = nullptr) {
   Render out;
   const OfxTime t = 0;
   fx.renderScale = scale;
@@ -152,20 +157,22 @@ Render render(Effect &fx, OfxPointD scale, const Where &w, bool interactive = fa
   OfxStatus s = fx.getRegionOfDefinitionAction(t, scale, rod);
   expectOk(s, w, "getRegionOfDefinition");
   if (s != kOfxStatOK && s != kOfxStatReplyDefault) return out;
-  fx.renderWindow = toPixels(rod, scale);
+  fx.renderWindow = tile ? *tile : toPixels(rod, scale);
   OfxRectI &win = fx.renderWindow;
   if (win.x2 <= win.x1 || win.y2 <= win.y1) {
     fail(w.text + ": empty region of definition");
     return out;
   }
-  OfxTime idTime = t;
-  std::string idClip;
-  s = fx.isIdentityAction(idTime, kOfxImageFieldNone, win, scale, idClip);
-  if (s == kOfxStatOK) {
-    fail(w.text + ": identity (" + idClip + ") where the morph moves pixels");
-    return out;
+  if (!tile) {
+    OfxTime idTime = t;
+    std::string idClip;
+    s = fx.isIdentityAction(idTime, kOfxImageFieldNone, win, scale, idClip);
+    if (s == kOfxStatOK) {
+      fail(w.text + ": identity (" + idClip + ") where the morph moves pixels");
+      return out;
+    }
+    expectOk(s, w, "isIdentity");
   }
-  expectOk(s, w, "isIdentity");
   expectOk(fx.beginRenderAction(t, t, 1, interactive, scale, !interactive, interactive), w,
            "beginSequenceRender");
   fx.regionsOfInterest.clear();
@@ -870,6 +877,39 @@ void checkNearest(Effect &fx, const Where &w) {
   if (moved == 0) fail(w.text + ": nearest: the warp moved nothing");
 }
 
+/// The frame rendered in four tiles split off-centre, as a host that
+/// renders in tiles asks for it, has the whole frame's bits (the maps'
+/// grids and lattices are fixed in the image, not in the window).
+void checkTiles(Effect &fx, const Where &w) {
+  const Render whole = render(fx, {1, 1}, w.with("whole"));
+  const std::vector<float> all = outputPixels(fx);
+  const OfxRectI frame = fx.renderWindow;
+  if (!whole.ok) return;
+  const int fw = frame.x2 - frame.x1, sx = frame.x1 + 37, sy = frame.y1 + 23;
+  const OfxRectI tiles[4] = {{frame.x1, frame.y1, sx, sy},
+                             {sx, frame.y1, frame.x2, sy},
+                             {frame.x1, sy, sx, frame.y2},
+                             {sx, sy, frame.x2, frame.y2}};
+  for (const OfxRectI &tile : tiles) {
+    if (!render(fx, {1, 1}, w.with("tile"), false, &tile).ok) return;
+    const std::vector<float> part = outputPixels(fx);
+    size_t k = 0;
+    for (int y = tile.y1; y < tile.y2; ++y)
+      for (int x = tile.x1; x < tile.x2; ++x)
+        for (int c = 0; c < 4; ++c, ++k) {
+          const float want = all[(size_t((y - frame.y1) * fw + (x - frame.x1))) * 4 + c];
+          if (std::memcmp(&part[k], &want, sizeof(float)) != 0) {
+            std::ostringstream m;
+            m.precision(9);
+            m << w.text << ": pixel (" << x << ", " << y << ") channel " << c << " is "
+              << part[k] << " rendered in the tile (" << tile.x1 << ", " << tile.y1 << ", "
+              << tile.x2 << ", " << tile.y2 << ") but " << want << " in the whole frame";
+            return fail(m.str());
+          }
+        }
+  }
+}
+
 /// One instance of `node` in `context`, its sources at `depth`.
 void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
                   const std::string &depth, const Where &where) {
@@ -914,6 +954,16 @@ void checkContext(IE::ImageEffectPlugin &plugin, const std::string &context,
         kOfxParamPropChoiceOption, m);
     const Where wm = w.with("method " + name);
     std::cout << "refhost: " << wm.text << std::endl;
+    if (depth == std::string(kOfxBitDepthFloat)) {
+      checkTiles(*fx, wm.with("tiles"));
+      // The mesh both ways: two-pass pictures, one-pass maps.
+      auto *pass = dynamic_cast<OFX::Host::Param::ChoiceInstance *>(fx->getParam("mesh_pass"));
+      if (name == "mesh" && pass) {
+        pass->set(choiceIndex(*fx, "mesh_pass", "one-pass"));
+        checkTiles(*fx, wm.with("one-pass tiles"));
+        pass->set(0);
+      }
+    }
     const Render full = render(*fx, {1, 1}, wm.with("scale 1"));
     const Render half = render(*fx, {0.5, 0.5}, wm.with("scale 0.5"));
     if (!full.ok || !half.ok) continue;
