@@ -51,17 +51,7 @@ pub fn layer_of(channel: &str) -> (&str, &str) {
     }
 }
 
-/// Whether a layer's name says it holds IDs or mattes, whose values must
-/// not be blended: `id` (`id`, `objectId`, `id2`), `crypto...`, and any
-/// name holding `mask` or `matte`.
-pub fn holds_ids(layer: &str) -> bool {
-    let n = layer.to_ascii_lowercase();
-    n.starts_with("id")
-        || n.ends_with("id")
-        || n.starts_with("crypto")
-        || n.contains("mask")
-        || n.contains("matte")
-}
+pub use morphfx::image::holds_ids;
 
 impl Layered {
     /// Every channel of the EXR at `path`.
@@ -231,23 +221,5 @@ mod tests {
         assert_eq!(layer_of("crypto00.R"), ("crypto00", "R"));
         assert_eq!(layer_of("diffuse.indirect.B"), ("diffuse.indirect", "B"));
         assert_eq!(layer_of("Z"), ("Z", "Z"));
-    }
-
-    #[test]
-    fn id_and_matte_layers_are_known_by_name() {
-        for id in [
-            "id",
-            "objectId",
-            "ID2",
-            "cryptomatte00",
-            "crypto_object",
-            "mask",
-            "holdout_matte",
-        ] {
-            assert!(holds_ids(id), "{id}");
-        }
-        for other in ["rgba", "N", "P", "diffuse", "Z", "motion"] {
-            assert!(!holds_ids(other), "{other}");
-        }
     }
 }

@@ -7,10 +7,12 @@
 
 pub(crate) mod direct_rgba;
 mod kernel;
+mod layer_names;
 pub mod resample;
 mod sample;
 mod warp_map;
 
+pub use layer_names::holds_ids;
 pub use resample::{resample, ResampleSettings};
 pub use sample::{EdgeMode, Filter, Sampler};
 pub use warp_map::WarpMap;
