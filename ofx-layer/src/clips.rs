@@ -12,6 +12,7 @@ use openfx::sys::image_effect_v1::param::*;
 use super::context::Context;
 use super::host::{self, Suites};
 use super::params::ParamSet;
+use super::planes;
 use super::props::PropSet;
 use super::{check, Failure, Outcome};
 
@@ -65,6 +66,7 @@ impl EffectHandle {
                 interact: None,
                 draw: None,
                 progress: None,
+                plane: None,
             },
         }
     }
@@ -344,10 +346,62 @@ impl Clip {
         let mut p: OfxPropertySetHandle = std::ptr::null_mut();
         // SAFETY: clip handle from the host; a null region asks for the whole image.
         let status = unsafe { f(self.handle, time, std::ptr::null(), &mut p) };
+        self.lent(status, p, time, planes::COLOUR)
+    }
+
+    /// The planes the host says the clip has (multi-planar hosts; colour
+    /// alone where it says nothing).
+    pub fn planes_present(&self) -> Vec<String> {
+        match self
+            .props()
+            .and_then(|p| p.get_strings(planes::PLANES_PRESENT))
+        {
+            Ok(planes) if !planes.is_empty() => planes,
+            _ => vec![planes::COLOUR.to_owned()],
+        }
+    }
+
+    /// The clip's image of `plane` at `time` (the plane suite; the colour
+    /// plane as [`Clip::image`]); `None` when the host has none, which the
+    /// extension says to take as transparent black.
+    pub fn image_plane(&self, time: f64, plane: &str) -> Outcome<Option<HostImage>> {
+        if planes::is_colour(plane) {
+            return self.image(time);
+        }
+        let f = self
+            .suites
+            .plane
+            .and_then(|s| s.clipGetImagePlane)
+            .ok_or_else(|| Failure::Failed("the host has no plane suite".into()))?;
+        let name = std::ffi::CString::new(plane)
+            .map_err(|_| Failure::Failed(format!("plane {plane:?} has a NUL in its name")))?;
+        let mut p: OfxPropertySetHandle = std::ptr::null_mut();
+        // SAFETY: clip handle from the host; the plane a NUL-terminated
+        // string; a null region asks for the whole image.
+        let status = unsafe { f(self.handle, time, name.as_ptr(), std::ptr::null(), &mut p) };
+        self.lent(status, p, time, plane)
+    }
+
+    /// The image a get-image call lent (`p`), owned so that it is released.
+    fn lent(
+        &self,
+        status: OfxStatus,
+        p: OfxPropertySetHandle,
+        time: f64,
+        plane: &str,
+    ) -> Outcome<Option<HostImage>> {
         if status == kOfxStatFailed || (status == kOfxStatOK && p.is_null()) {
             return Ok(None);
         }
-        check(status, &format!("image of clip {} at {time}", self.name))?;
+        let what = match planes::is_colour(plane) {
+            true => format!("image of clip {} at {time}", self.name),
+            false => format!(
+                "plane {} of clip {} at {time}",
+                planes::name_of(plane),
+                self.name
+            ),
+        };
+        check(status, &what)?;
         // SAFETY: the host just lent us this image; it stays valid until
         // clipReleaseImage, which only HostImage's Drop calls.
         let props = unsafe { PropSet::from_raw(p)? };
@@ -452,12 +506,9 @@ fn image_info(p: &PropSet, clip: &str) -> Outcome<ImageInfo> {
             )))
         }
     };
-    let channels = match p.get_string(kOfxImageEffectPropComponents, 0)?.as_str() {
-        "OfxImageComponentRGBA" => 4,
-        "OfxImageComponentRGB" => 3,
-        "OfxImageComponentAlpha" => 1,
-        other => return Err(bad(format!("unsupported components {other}"))),
-    };
+    let components = p.get_string(kOfxImageEffectPropComponents, 0)?;
+    let channels = planes::channels_of(&components)
+        .ok_or_else(|| bad(format!("unsupported components {components}")))?;
     let [x1, y1, x2, y2] = p.get_ints::<4>(kOfxImagePropBounds)?;
     let premult = p
         .get_string(kOfxImageEffectPropPreMultiplication, 0)

@@ -11,7 +11,7 @@ use super::plugin::{
     Components, Context, ContextSpec, ImageEffect, PixelDepth, Sequential, ThreadSafety,
 };
 use super::props::PropSet;
-use super::{host, interact, Outcome};
+use super::{host, interact, planes, Outcome};
 
 /// The describe action: labels, contexts, depths, capabilities, overlay.
 pub(super) fn describe<E: ImageEffect>(effect: &EffectHandle) -> Outcome {
@@ -64,6 +64,14 @@ pub(super) fn describe<E: ImageEffect>(effect: &EffectHandle) -> Outcome {
         0,
         sequential_value(caps.sequential),
     );
+    // Every plane of the sources, where the host can hand them out; planes
+    // the output does not make (none, for an effect that makes them all)
+    // pass through rather than vanish.
+    if E::MULTI_PLANE && host::multi_planar() {
+        let _ = p.set_int(planes::MULTI_PLANAR, 0, 1);
+        let _ = p.set_int(planes::PASS_THROUGH_COMPONENTS, 0, 1);
+        let _ = p.set_int(planes::RENDER_ALL_PLANES, 0, 1);
+    }
     // The viewer overlay, where the effect has one: OpenGL (V1) for every
     // host that draws overlays, the Draw suite entry (V2) only where the
     // host offers that suite.

@@ -15,7 +15,7 @@ use super::attach::{attachment, create, detach};
 use super::clips::EffectHandle;
 use super::plugin::{ClipPreferences, FramesNeeded, ImageEffect, ParamChange, RenderArgs, Rois};
 use super::props::PropSet;
-use super::{describe, host, Failure, Outcome, Reply, BAD_INPUT_ID};
+use super::{describe, host, planes, Failure, Outcome, Reply, BAD_INPUT_ID};
 
 /// The main entry point of node type `E` (`OfxPluginEntryPoint`).
 ///
@@ -150,6 +150,8 @@ fn run<E: ImageEffect>(
         render::<E>(&effect, &in_props()?)?;
     } else if action == kOfxActionInstanceChanged {
         param_changed::<E>(&effect, &in_props()?)?;
+    } else if action == planes::GET_CLIP_COMPONENTS {
+        return clip_planes::<E>(&effect, &in_props()?, &out_props()?);
     } else {
         return Ok(Reply::Default);
     }
@@ -257,7 +259,33 @@ fn render_args(in_args: &PropSet) -> Outcome<RenderArgs> {
             .get_int(kOfxImageEffectPropInteractiveRenderStatus, 0)
             .unwrap_or(0)
             == 1,
+        // Hosts without the extension have no such property: colour alone.
+        planes: in_args
+            .get_strings(planes::RENDER_PLANES)
+            .unwrap_or_default(),
     })
+}
+
+/// `GetClipComponents`: the planes each clip needs and the output makes,
+/// and where the rest pass through from.
+fn clip_planes<E: ImageEffect>(
+    effect: &EffectHandle,
+    in_args: &PropSet,
+    out_args: &PropSet,
+) -> Outcome<Reply> {
+    let time = in_args.get_double(kOfxPropTime, 0)?;
+    let mut answer = planes::ClipPlanes::default();
+    let reply = with_node(effect, |n: &E| n.clip_planes(effect, time, &mut answer))?;
+    for (clip, list) in &answer.needed {
+        let prop = CString::new(format!("{}{clip}", planes::NEEDED_PREFIX)).unwrap_or_default();
+        let list: Vec<&str> = list.iter().map(String::as_str).collect();
+        out_args.set_strings(&prop, &list)?;
+    }
+    if let Some((clip, at)) = answer.pass_through {
+        out_args.set_string(planes::PASS_THROUGH_CLIP, 0, clip)?;
+        out_args.set_double(planes::PASS_THROUGH_TIME, 0, at)?;
+    }
+    Ok(reply)
 }
 
 fn is_identity<E: ImageEffect>(

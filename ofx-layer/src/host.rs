@@ -1,7 +1,7 @@
 //! The host's suites, fetched once in the load action and shared by all threads.
 
 use std::ffi::CStr;
-use std::sync::atomic::{AtomicPtr, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 use std::sync::RwLock;
 
 use openfx::sys::generic::core::*;
@@ -13,6 +13,7 @@ use openfx::sys::image_effect_v1::message::*;
 use openfx::sys::image_effect_v1::param::*;
 use openfx::sys::image_effect_v1::progress::*;
 
+use super::planes::{self, PlaneSuiteV1};
 use super::{Failure, Outcome};
 use crate::sync::RwLocked;
 
@@ -30,6 +31,8 @@ pub struct Suites {
     pub draw: Option<&'static OfxDrawSuiteV1>,
     /// Progress of long work outside renders (tracking), with cancel.
     pub progress: Option<&'static OfxProgressSuiteV1>,
+    /// The Foundry's plane suite: planes besides colour (multi-planar hosts).
+    pub plane: Option<&'static PlaneSuiteV1>,
 }
 
 // SAFETY: the suites are immutable function tables the host keeps alive for as
@@ -105,6 +108,7 @@ pub fn load() -> Outcome {
     let interact = get(kOfxInteractSuite, 1) as *const OfxInteractSuiteV1;
     let draw = get(kOfxDrawSuite, 1) as *const OfxDrawSuiteV1;
     let progress = get(kOfxProgressSuite, 1) as *const OfxProgressSuiteV1;
+    let plane = get(planes::PLANE_SUITE, 1) as *const PlaneSuiteV1;
     // SAFETY: the host returned these pointers for the named suite versions;
     // they stay valid until the binary is unloaded.
     let suites = unsafe {
@@ -117,12 +121,30 @@ pub fn load() -> Outcome {
             interact: interact.as_ref(),
             draw: draw.as_ref(),
             progress: progress.as_ref(),
+            plane: plane.as_ref(),
         }
     };
     switches();
     // A later load (a host that reloads us) replaces the suites.
     *SUITES.write_locked() = Some(suites);
+    let planar = suites.prop.propGetInt.is_some_and(|get| {
+        let mut v = 0;
+        // SAFETY: the host descriptor's property set, which the host keeps
+        // for as long as the binary is loaded; a NUL-terminated name and a
+        // live out-pointer.
+        let status = unsafe { get(host.host, planes::MULTI_PLANAR.as_ptr(), 0, &mut v) };
+        status == kOfxStatOK && v == 1
+    });
+    MULTI_PLANAR.store(planar && suites.plane.is_some(), Ordering::Release);
     Ok(())
+}
+
+static MULTI_PLANAR: AtomicBool = AtomicBool::new(false);
+
+/// The host says it is multi-planar and has the plane suite: effects may
+/// read and make planes besides colour.
+pub fn multi_planar() -> bool {
+    MULTI_PLANAR.load(Ordering::Acquire)
 }
 
 /// The message suite of the last load, kept apart from [`SUITES`] so that a

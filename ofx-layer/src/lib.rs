@@ -19,6 +19,7 @@ mod interact;
 pub mod keys;
 pub mod paint;
 pub mod params;
+pub mod planes;
 pub mod plugin;
 mod props;
 pub mod spec;

@@ -224,6 +224,7 @@ fn set_kind(p: &PropSet, kind: &Kind) -> Outcome {
         Kind::Text { default, mode } => {
             p.set_string(kOfxParamPropDefault, 0, default)?;
             let mode: &CStr = match mode {
+                TextMode::SingleLine => kOfxParamStringIsSingleLine,
                 TextMode::MultiLine => kOfxParamStringIsMultiLine,
                 TextMode::FilePath => kOfxParamStringIsFilePath,
             };

@@ -13,6 +13,7 @@ use super::clips::EffectHandle;
 pub use super::context::Context;
 use super::paint::Painter;
 use super::params::Params;
+pub use super::planes::ClipPlanes;
 use super::spec::{Id, ParamSpec};
 use super::{Outcome, Reply};
 
@@ -91,7 +92,7 @@ pub struct ContextSpec {
 }
 
 /// A render or an identity question: one window of one frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RenderArgs {
     pub time: f64,
     /// Pixels.
@@ -102,6 +103,9 @@ pub struct RenderArgs {
     /// manipulated, where the spec allows an approximation for UI purposes
     /// (`kOfxImageEffectPropInteractiveRenderStatus`).
     pub interactive: bool,
+    /// The planes to fill (multi-planar hosts; see [`crate::planes`]): the
+    /// colour plane alone where the host names none.
+    pub planes: Vec<String>,
 }
 
 /// The clip (and its time) a node's output equals at some frame.
@@ -188,6 +192,10 @@ pub trait ImageEffect: Sized + Send + Sync + 'static {
     const GROUPING: &'static str;
     const CONTEXTS: &'static [Context];
     const CAPABILITIES: Capabilities;
+    /// The effect reads and makes every plane of its sources where the host
+    /// offers the multi-plane extension: it then answers
+    /// [`ImageEffect::clip_planes`] and fills every plane a render names.
+    const MULTI_PLANE: bool = false;
     /// The viewer overlay, if the effect draws one:
     /// `Some(OverlayActions::of::<TheOverlay>())`.
     const OVERLAY: Option<OverlayActions<Self>> = None;
@@ -242,6 +250,17 @@ pub trait ImageEffect: Sized + Send + Sync + 'static {
 
     fn param_changed(&self, _effect: &EffectHandle, _change: &ParamChange) -> Outcome {
         Ok(())
+    }
+
+    /// The planes each clip needs at `time` and the output makes
+    /// (multi-planar effects, `GetClipComponents`).
+    fn clip_planes(
+        &self,
+        _effect: &EffectHandle,
+        _time: f64,
+        _out: &mut ClipPlanes,
+    ) -> Outcome<Reply> {
+        Ok(Reply::Default)
     }
 }
 
@@ -388,6 +407,7 @@ mod tests {
             window: RectI::default(),
             sequential: false,
             interactive: false,
+            planes: Vec::new(),
         };
         let m = Minimal;
         assert_eq!(m.region_of_definition(&effect, time), Ok(None));
@@ -410,5 +430,12 @@ mod tests {
             time,
         };
         assert_eq!(m.param_changed(&effect, &change), Ok(()));
+        const { assert!(!Minimal::MULTI_PLANE) };
+        let mut planes = ClipPlanes::default();
+        assert_eq!(
+            m.clip_planes(&effect, time, &mut planes),
+            Ok(Reply::Default)
+        );
+        assert_eq!(planes, ClipPlanes::default());
     }
 }

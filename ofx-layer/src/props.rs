@@ -114,6 +114,12 @@ impl PropSet {
         call!(self, propGetPointer, name, index, &mut v)?;
         Ok(v)
     }
+    /// Every value of a string property.
+    pub fn get_strings(&self, name: &CStr) -> Outcome<Vec<String>> {
+        let mut n = 0;
+        call!(self, propGetDimension, name, &mut n)?;
+        (0..n).map(|i| self.get_string(name, i)).collect()
+    }
     pub fn get_string(&self, name: &CStr, index: i32) -> Outcome<String> {
         let mut v: *mut c_char = std::ptr::null_mut();
         call!(self, propGetString, name, index, &mut v)?;

@@ -13,6 +13,7 @@ use morphfx::choice::Choice;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TextMode {
+    SingleLine,
     MultiLine,
     FilePath,
 }
