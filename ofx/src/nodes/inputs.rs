@@ -96,7 +96,7 @@ pub(in crate::nodes) fn progress_at(
 }
 
 /// Everything the warps at one time depend on.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct WarpInputs {
     pub features: Vec<Feature>,
     pub warp: WarpSettings,

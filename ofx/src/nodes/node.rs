@@ -16,9 +16,9 @@ use ofx_layer::clips::EffectHandle;
 use ofx_layer::paint::Painter;
 use ofx_layer::params::Params;
 use ofx_layer::plugin::{
-    Capabilities, ClipPreferences, ClipSpec, Components, Context, ContextSpec, DrawArgs,
-    FramesNeeded, Identity, ImageEffect, Overlay, OverlayActions, ParamChange, Pen, PixelDepth,
-    RenderArgs, Rois, Sequential, ThreadSafety,
+    Capabilities, ClipPlanes, ClipPreferences, ClipSpec, Components, Context, ContextSpec,
+    DrawArgs, FramesNeeded, Identity, ImageEffect, Overlay, OverlayActions, ParamChange, Pen,
+    PixelDepth, RenderArgs, Rois, Sequential, ThreadSafety,
 };
 use ofx_layer::{Outcome, Reply};
 
@@ -74,6 +74,7 @@ impl<N: Node> ImageEffect for Effect<N> {
         sequential: Sequential::Preferred,
     };
     const OVERLAY: Option<OverlayActions<Self>> = Some(OverlayActions::of::<FeatureOverlay>());
+    const MULTI_PLANE: bool = true;
 
     fn describe_in_context(context: Context) -> ContextSpec {
         let (a, b) = N::KIND.source_clips(context);
@@ -158,6 +159,15 @@ impl<N: Node> ImageEffect for Effect<N> {
 
     fn param_changed(&self, effect: &EffectHandle, change: &ParamChange) -> Outcome {
         param_changed(self.state(), effect, change)
+    }
+
+    fn clip_planes(
+        &self,
+        effect: &EffectHandle,
+        time: f64,
+        out: &mut ClipPlanes,
+    ) -> Outcome<Reply> {
+        render::clip_planes(self.state(), effect, time, out)
     }
 }
 

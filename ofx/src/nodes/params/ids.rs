@@ -30,6 +30,7 @@ pub const SCENE_TEXT: Id<Text> = Id::new("scene_text");
 pub const OFFSET_A: Id<Int> = Id::new("frame_offset_a");
 pub const OFFSET_B: Id<Int> = Id::new("frame_offset_b");
 pub const FILTER: Id<Choose<Filter>> = Id::new("filter");
+pub const ID_LAYERS: Id<Text> = Id::new("id_layers");
 pub const EDGE: Id<Choose<EdgeMode>> = Id::new("edge");
 pub const VIEW: Id<Indexed> = Id::new("view");
 pub const MESH_PASS: Id<Choose<Pass>> = Id::new("mesh_pass");

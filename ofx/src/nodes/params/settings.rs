@@ -36,6 +36,8 @@ pub struct Settings {
     pub offset_a: i32,
     pub offset_b: i32,
     pub filter: Filter,
+    /// Layers sampled nearest besides those whose names say IDs.
+    pub id_layers: Vec<String>,
     pub edge: EdgeMode,
     pub view: View,
     /// What a timing matte paces (the Transition group's Affects).
@@ -106,6 +108,13 @@ impl Settings {
             offset_a: r.int(&OFFSET_A),
             offset_b: if kind.has_b() { r.int(&OFFSET_B) } else { 0 },
             filter: r.choice(&FILTER),
+            id_layers: r
+                .text(&ID_LAYERS)
+                .split(',')
+                .map(str::trim)
+                .filter(|n| !n.is_empty())
+                .map(str::to_owned)
+                .collect(),
             edge: r.choice(&EDGE),
             view: r.pick(&VIEW, kind.views),
             affects: r.choice(&TRANSITION_AFFECTS),

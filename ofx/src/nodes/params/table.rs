@@ -666,6 +666,20 @@ pub(super) fn build_table(kind: &'static NodeKind) -> Vec<ParamSpec> {
             source pixel itself, unblended: for IDs and mattes).",
             Filter::Bilinear,
         ),
+        ID_LAYERS
+            .spec(
+                "ID Layers",
+                "In hosts that hand every layer to the node (Natron's multi-plane \
+                extension), the layers besides the colour go through the same warp; \
+                those whose names say IDs or mattes (id, objectId, crypto*, any name \
+                with mask or matte), and those listed here (comma-separated), are \
+                sampled nearest and never blended.",
+                Texts {
+                    default: "",
+                    mode: TextMode::SingleLine,
+                },
+            )
+            .animated(false),
         EDGE.spec(
             "Edge",
             "Outside the source: clamp to the edge pixels, black (transparent), \

@@ -5,6 +5,7 @@
 //! aspect happen here, once: the core sees canonical coordinates only.
 
 mod draw;
+mod planes;
 mod regions;
 mod warm;
 
@@ -33,6 +34,7 @@ use draw::Job;
 use ofx_layer::clips::{Depth, EffectHandle, HostImage, HostSample};
 use ofx_layer::plugin::RenderArgs;
 use ofx_layer::{Failure, Outcome};
+pub use planes::clip_planes;
 pub use regions::{
     clip_preferences, frames_needed, is_identity, region_of_definition, regions_of_interest,
 };
@@ -60,10 +62,70 @@ macro_rules! with_depth {
 mod blur;
 mod mattes;
 
-/// The render action: gather, prepare, draw.
+/// The render action: gather, prepare, draw; for each plane the host asks
+/// for (colour, and the others where it has the multi-plane extension).
 pub fn render(instance: &NodeState, effect: &EffectHandle, args: &RenderArgs) -> Outcome {
+    let (request, lent) = gather(instance, effect, args)?;
+    if effect.aborted() {
+        return Ok(());
+    }
+    let others = args
+        .planes
+        .iter()
+        .filter(|p| !ofx_layer::planes::is_colour(p))
+        .map(|p| plane_request(instance, effect, &request, p))
+        .collect::<Outcome<Vec<_>>>()?;
+    if planes::colour_asked(&args.planes) {
+        render_plane(instance, effect, request, lent)?;
+    }
+    for (request, lent) in others {
+        render_plane(instance, effect, request, lent)?;
+    }
+    Ok(())
+}
+
+/// A plane besides colour: the colour's request over the plane's images,
+/// drawn as [`planes::treatment`] says, and the images it holds.
+fn plane_request(
+    instance: &NodeState,
+    effect: &EffectHandle,
+    request: &Request,
+    plane: &str,
+) -> Outcome<(Request, Lent)> {
     let kind = instance.kind;
-    let (mut request, mut lent) = gather(instance, effect, args)?;
+    let (a_name, b_name) = kind.source_clips(instance.context);
+    let (time, settings) = (request.time, &request.settings);
+    let a = planes::plane_image(effect, a_name, time + settings.offset_a as f64, plane)?;
+    let b = match b_name {
+        Some(b) => planes::plane_image(effect, b, time + settings.offset_b as f64, plane)?,
+        None => None,
+    };
+    let out = planes::output_image(effect, time, plane)?;
+    let how = planes::treatment(plane, settings, kind.has_b(), request.inputs.t);
+    let mut r = request.clone();
+    r.depth = source_depth(&a, &b, out.info().depth)?;
+    r.sources = [&a, &b].map(|s| s.as_ref().map(source_of));
+    (r.settings.view, r.settings.filter, r.ids) = (how.view, how.filter, how.ids);
+    r.fixed = Some((how.view, how.filter));
+    if how.ids {
+        r.settings.shutter.samples = 0;
+    }
+    let mask = match how.view.is_picture() {
+        true => source(effect, MASK_CLIP, time)?,
+        false => None,
+    };
+    let sources = [a, b];
+    Ok((r, Lent { sources, mask, out }))
+}
+
+/// One plane of the output: the view, blurred or not.
+fn render_plane(
+    instance: &NodeState,
+    effect: &EffectHandle,
+    mut request: Request,
+    mut lent: Lent,
+) -> Outcome {
+    let kind = instance.kind;
     if effect.aborted() {
         return Ok(());
     }
@@ -175,6 +237,7 @@ struct Source {
 
 /// What one render reads from the host, holding no host handle: everything
 /// [`prepare`] needs, so it can be made by hand in tests.
+#[derive(Clone)]
 struct Request {
     time: f64,
     window: RectI,
@@ -196,6 +259,10 @@ struct Request {
     work: Option<Arc<[WorkImage; 2]>>,
     /// The Timing input's matte (Morph node, connected).
     timing: Option<Arc<Matte>>,
+    /// The plane holds IDs or mattes: Mix and the Mask switch, not blend.
+    ids: bool,
+    /// A plane's view and filter, held over a blurred frame's samples.
+    fixed: Option<(View, Filter)>,
 }
 
 impl Request {
@@ -209,7 +276,10 @@ impl Request {
         instance: &NodeState,
         time: f64,
     ) -> Outcome<Request> {
-        let settings = read_settings(kind, effect, instance, time)?;
+        let mut settings = read_settings(kind, effect, instance, time)?;
+        if let Some((view, filter)) = self.fixed {
+            (settings.view, settings.filter) = (view, filter);
+        }
         let mut inputs = warp_inputs(instance, &settings, time)?;
         if let Some(matte) = &self.timing {
             inputs.warp.settings.transition = mattes::timed(matte.clone(), &settings);
@@ -289,10 +359,13 @@ fn gather(
     } else {
         None
     };
-    let out = effect
-        .clip("Output")?
-        .image(time)?
-        .ok_or_else(|| Failure::Failed("the host gave no output image".into()))?;
+    // The output's scale and depth, from the colour plane unless the host
+    // asks for other planes alone.
+    let first = match planes::colour_asked(&args.planes) {
+        true => ofx_layer::planes::COLOUR,
+        false => args.planes[0].as_str(),
+    };
+    let out = planes::output_image(effect, time, first)?;
     // The spec: non-optional clips are always connected during a render.
     let rod = regions::output_region(instance, effect, time)?.ok_or_else(|| {
         Failure::BadInput(format!("no source clip of {} is connected", kind.label))
@@ -301,16 +374,7 @@ fn gather(
     inputs.warp.region = Some(regions::warp_region(effect, &rod));
     let out_scale = out.info().pixel_scale();
     let depth = source_depth(&a, &b, out.info().depth)?;
-    let sources = [&a, &b].map(|s| {
-        s.as_ref().map(|image| {
-            let i = image.info();
-            Source {
-                scale: i.pixel_scale(),
-                covers: canonical(i.bounds, i.pixel_scale()),
-                premultiplied: i.premultiplied,
-            }
-        })
-    });
+    let sources = [&a, &b].map(|s| s.as_ref().map(source_of));
     let work = match inputs.warp.method() {
         Method::Auto => Some(Arc::new(work_images(&a, &b, depth)?)),
         _ => None,
@@ -328,6 +392,8 @@ fn gather(
         project: regions::project(effect, &rod),
         work,
         timing,
+        ids: false,
+        fixed: None,
     };
     let lent = Lent {
         sources: [a, b],
@@ -361,6 +427,16 @@ fn read_settings(
         );
     }
     Ok(settings)
+}
+
+/// What a source image's properties say.
+fn source_of(image: &HostImage) -> Source {
+    let i = image.info();
+    Source {
+        scale: i.pixel_scale(),
+        covers: canonical(i.bounds, i.pixel_scale()),
+        premultiplied: i.premultiplied,
+    }
 }
 
 /// Both sources are read at one depth (the descriptor says so); a missing
@@ -687,14 +763,23 @@ fn draw_rows<D: Sample>(
             // (transparent outside it) and stored once.
             let mut effect = Image::new(rows.bounds, rows.channels);
             job.draw(&a, b, effect.view_mut().rows());
-            let unwarped = Sampler::new(src, a_scale, Filter::Bilinear, EdgeMode::Black, a_pre);
+            let unwarped_filter = if request.ids { Filter::Nearest } else { Filter::Bilinear };
+            let unwarped = Sampler::new(src, a_scale, unwarped_filter, EdgeMode::Black, a_pre);
             let identity = WarpMap::identity(rows.bounds, request.out_scale);
             let source = Warped::Map(&unwarped, &identity);
-            let plane = mask.as_ref().map(|m| m(rows.bounds, request.out_scale));
+            let mut plane = mask.as_ref().map(|m| m(rows.bounds, request.out_scale));
+            let mut amount = settings.mix as f32;
+            if request.ids {
+                // IDs are taken whole, from the effect or the source.
+                amount = amount.round();
+                for m in plane.iter_mut().flat_map(|p| p.data.iter_mut()) {
+                    *m = m.round();
+                }
+            }
             let how = Mix {
                 source: if job.premultiply[0] { Warped::Premultiplied(&source) } else { source },
                 mask: plane.as_ref(),
-                amount: settings.mix as f32,
+                amount,
                 invert: settings.mask_invert,
             };
             mix(&effect, &how, rows);
@@ -762,6 +847,8 @@ mod tests {
             project: (Vec2::new(0.0, 0.0), Vec2::new(64.0, 48.0)),
             work: None,
             timing: None,
+            ids: false,
+            fixed: None,
         }
     }
 
