@@ -13,6 +13,7 @@ fn without_a_draw_suite_or_gl_context_draw_is_a_no_op_and_editing_works() {
     let options = HostOptions {
         overlays: true,
         draw_suite: false,
+        multi_plane: false,
     };
     let bundle = Bundle::load_with(&common::bundle_path(), options).unwrap();
     let inst = bundle

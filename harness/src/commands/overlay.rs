@@ -61,6 +61,7 @@ impl Job {
         let options = HostOptions {
             overlays: true,
             draw_suite: true,
+            multi_plane: false,
         };
         let bundle = Bundle::load_with(bundle_path, options)?;
         let inst = bundle.instance(self.plugin, self.context)?;

@@ -18,7 +18,7 @@ use openfx::sys::image_effect_v1::time_line::kOfxTimeLineSuite;
 use super::checks::violation;
 use super::effect::{Effect, Message};
 use super::props::PropertySet;
-use super::{effect, guard, interact_suites, misuse, params, props, services};
+use super::{effect, guard, interact_suites, misuse, params, planes, props, services};
 use crate::error::{HostError, BAD_INPUT_ID};
 use crate::sync::Locked;
 
@@ -29,6 +29,8 @@ pub struct HostOptions {
     pub overlays: bool,
     /// The OFX 1.5 Draw suite, recording every call.
     pub draw_suite: bool,
+    /// The multi-plane extension, as Natron offers it (`planes`).
+    pub multi_plane: bool,
 }
 
 /// Whether the loaded host whose property set is `host` has int property
@@ -98,6 +100,9 @@ unsafe extern "C" fn fetch_suite(
                     && offers(host, interact_suites::DRAW_SUITE_PROP) =>
             {
                 &interact_suites::DRAW_SUITE as *const _ as *const c_void
+            }
+            (n, 1) if n == planes::PLANE_SUITE && offers(host, planes::MULTI_PLANAR) => {
+                &planes::SUITE as *const _ as *const c_void
             }
             // Anything else (OpenGL render, dialogs, ...) this host does not provide: a
             // null answer is how OFX says so.
@@ -194,6 +199,7 @@ fn host_properties(options: HostOptions) -> Box<PropertySet> {
         interact_suites::DRAW_SUITE_PROP,
         &[options.draw_suite as i32],
     );
+    host_props.set_int(planes::MULTI_PLANAR, &[options.multi_plane as i32]);
     host_props.set_int(kOfxImageEffectPropSupportsMultiResolution, &[1]);
     host_props.set_int(kOfxImageEffectPropSupportsTiles, &[1]);
     host_props.set_int(kOfxImageEffectPropTemporalClipAccess, &[1]);

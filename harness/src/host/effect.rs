@@ -49,6 +49,10 @@ pub struct Clip {
     pub source: Mutex<Option<Arc<dyn FrameSource>>>,
     /// The buffer renders write into (output clip).
     pub output: Mutex<Option<Arc<Frame>>>,
+    /// Planes besides colour, by plane string (multi-planar hosts).
+    pub planes: Mutex<Vec<(String, Arc<dyn FrameSource>)>>,
+    /// The buffers of those planes a render writes into (output clip).
+    pub output_planes: Mutex<Vec<(String, Arc<Frame>)>>,
     /// The last proxy made: the source frame it came from, its render
     /// scale, and the proxy. A host keeps proxies rather than filtering
     /// the plate again for every render at the same scale.
@@ -145,6 +149,8 @@ impl Effect {
             props,
             source: Mutex::new(None),
             output: Mutex::new(None),
+            planes: Mutex::new(Vec::new()),
+            output_planes: Mutex::new(Vec::new()),
             proxy: Mutex::new(None),
             effect: self,
         });
@@ -183,7 +189,7 @@ pub(super) fn live_effect<'a>(h: *const c_void) -> Option<&'a Effect> {
 /// # Safety
 /// `h` is null or a handle this host's clipGetHandle gave out, whose effect
 /// is still alive (OFX requires a plugin to pass only such handles).
-unsafe fn clip_of<'a>(h: OfxImageClipHandle) -> Option<&'a Clip> {
+pub(super) unsafe fn clip_of<'a>(h: OfxImageClipHandle) -> Option<&'a Clip> {
     // SAFETY: clip handles we hand out point at boxed Clips of a live effect.
     unsafe { (h as *const Clip).as_ref() }
 }
@@ -297,7 +303,7 @@ unsafe extern "C" fn clip_get_property_set(
 }
 
 impl Clip {
-    fn effect(&self) -> &Effect {
+    pub(super) fn effect(&self) -> &Effect {
         // SAFETY: a clip never outlives its effect.
         unsafe { &*self.effect }
     }
@@ -347,7 +353,7 @@ impl Clip {
     }
 }
 
-unsafe extern "C" fn clip_get_image(
+pub(super) unsafe extern "C" fn clip_get_image(
     clip: OfxImageClipHandle,
     time: OfxTime,
     _region: *const OfxRectD,

@@ -13,6 +13,7 @@ use super::bundle::{accept, failure, Bundle};
 use super::effect::{Effect, FrameSource, Message};
 use super::frame::{self, Frame};
 use super::params::{self, ParamValue};
+use super::planes;
 use super::props::PropertySet;
 use crate::error::HostError;
 use crate::sync::Locked;
@@ -86,6 +87,26 @@ pub struct Instance<'b> {
     plugin: *const OfxPlugin,
     _descriptor: Box<Effect>,
     pub effect: Box<Effect>,
+}
+
+/// A multi-planar plugin's answer to `GetClipComponents`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClipPlanes {
+    /// Each clip's planes: those an input needs, those the output makes.
+    pub needed: Vec<(String, Vec<String>)>,
+    /// The clip planes not made pass through from.
+    pub pass_through: Option<String>,
+}
+
+impl ClipPlanes {
+    /// The planes `clip` needs (makes, for the output).
+    pub fn needs(&self, clip: &str) -> Vec<String> {
+        self.needed
+            .iter()
+            .find(|(c, _)| c == clip)
+            .map(|(_, p)| p.clone())
+            .unwrap_or_default()
+    }
 }
 
 /// How the output image is laid out (for testing host variety).
@@ -322,6 +343,116 @@ impl Instance<'_> {
         *c.source.locked() = Some(source);
         c.props.set_int(kOfxImageClipPropConnected, &[1]);
         Ok(())
+    }
+
+    /// Gives `clip` planes besides its colour (a multi-planar host's
+    /// layers): `(plane string, source)` each, listed in the clip's
+    /// planes-present property after the colour.
+    pub fn connect_planes(
+        &self,
+        clip: &str,
+        planes: Vec<(String, Arc<dyn FrameSource>)>,
+    ) -> Result<(), HostError> {
+        let c = self
+            .effect
+            .clip(clip)
+            .ok_or_else(|| HostError::bad(format!("the plugin has no clip {clip}")))?;
+        let mut present = vec![planes::COLOUR.to_owned()];
+        present.extend(planes.iter().map(|(p, _)| p.clone()));
+        let present: Vec<&str> = present.iter().map(String::as_str).collect();
+        c.props.set_strs(planes::PLANES_PRESENT, &present);
+        *c.planes.locked() = planes;
+        Ok(())
+    }
+
+    /// The multi-plane extension's question: which planes each clip needs
+    /// and the output makes at `time` (`NeededComp_<clip>`), and the clip
+    /// the rest pass through from; `None` where the plugin leaves it to
+    /// the host.
+    pub fn clip_planes(&self, time: f64) -> Result<Option<ClipPlanes>, HostError> {
+        let a = PropertySet::new();
+        a.set_double(kOfxPropTime, &[time]);
+        let out = PropertySet::new();
+        if self.act(planes::GET_CLIP_COMPONENTS, Some(&a), Some(&out))? != kOfxStatOK {
+            return Ok(None);
+        }
+        let needed = self
+            .effect
+            .clip_names()
+            .into_iter()
+            .map(|c| {
+                let prop =
+                    CString::new(format!("{}{c}", planes::NEEDED_PREFIX)).unwrap_or_default();
+                let list = out.strs(&prop);
+                (c, list)
+            })
+            .collect();
+        let pass_through = out.strs(planes::PASS_THROUGH_CLIP).into_iter().next();
+        Ok(Some(ClipPlanes {
+            needed,
+            pass_through,
+        }))
+    }
+
+    /// Renders `planes` of frame `time` in one render action each window
+    /// (the plugin asked for that, `RenderAllPlanes`), as a multi-planar
+    /// host does: the colour plane laid out as `spec`, every other plane a
+    /// float buffer of its own channel count. Each must be one the plugin
+    /// said it makes.
+    pub fn render_planes(
+        &self,
+        time: f64,
+        spec: OutputSpec,
+        asked: &[String],
+    ) -> Result<Vec<(String, Arc<Frame>)>, HostError> {
+        let made = self
+            .clip_planes(time)?
+            .map(|c| c.needs("Output"))
+            .unwrap_or_else(|| vec![planes::COLOUR.to_owned()]);
+        for p in asked {
+            if !made.contains(p) {
+                return Err(HostError::failed(format!(
+                    "the plugin does not make plane {p} (it makes {})",
+                    made.join(", ")
+                )));
+            }
+        }
+        let field = "OfxImageFieldNone";
+        self.set_render_state(time, spec.render_scale, field);
+        let bounds = self.output_bounds(time, spec.render_scale)?;
+        let out_clip = self
+            .effect
+            .clip("Output")
+            .ok_or_else(|| HostError::failed("the plugin has no Output clip"))?;
+        let mut frames = Vec::new();
+        for p in asked {
+            let (channels, depth) = match p == planes::COLOUR {
+                true => (spec.channels, spec.depth),
+                false => (
+                    planes::channels(p)
+                        .ok_or_else(|| HostError::failed(format!("no such plane: {p}")))?,
+                    "OfxBitDepthFloat",
+                ),
+            };
+            let mut f = Frame::blank(bounds, channels, depth, spec.top_down);
+            f.par = self.pixel_aspect();
+            frames.push((p.clone(), Arc::new(f)));
+        }
+        let colour = frames.iter().find(|(p, _)| p == planes::COLOUR);
+        *out_clip.output.locked() = colour.map(|(_, f)| f.clone());
+        *out_clip.output_planes.locked() = frames
+            .iter()
+            .filter(|(p, _)| p != planes::COLOUR)
+            .cloned()
+            .collect();
+        out_clip
+            .props
+            .set_str(kOfxImageEffectPropPixelDepth, spec.depth);
+        let result = self.render_tiles(time, spec, field, bounds, asked);
+        *out_clip.output.locked() = None;
+        out_clip.output_planes.locked().clear();
+        result?;
+        Ok(frames)
     }
 
     /// Leaves `clip` unconnected, as a host does when its input is cut.
@@ -694,7 +825,7 @@ impl Instance<'_> {
         out_clip
             .props
             .set_str(kOfxImageEffectPropPixelDepth, spec.depth);
-        let result = self.render_tiles(time, spec, field, bounds);
+        let result = self.render_tiles(time, spec, field, bounds, &[]);
         *out_clip.output.locked() = None;
         result?;
         Ok(out)
@@ -750,6 +881,7 @@ impl Instance<'_> {
         spec: OutputSpec,
         field: &'static str,
         bounds: RectI,
+        planes: &[String],
     ) -> Result<(), HostError> {
         let tiles = spec.tiles.max(1) as i32;
         let band = (bounds.height() as i32 + tiles - 1) / tiles;
@@ -779,6 +911,10 @@ impl Instance<'_> {
                 kOfxImageEffectPropInteractiveRenderStatus,
                 &[spec.interactive as i32],
             );
+            if !planes.is_empty() {
+                let planes: Vec<&str> = planes.iter().map(String::as_str).collect();
+                a.set_strs(planes::RENDER_PLANES, &planes);
+            }
             self.act(kOfxImageEffectActionRender, Some(&a), None)
                 .map(|_| ())
         };

@@ -13,6 +13,7 @@ mod interact_suites;
 pub mod misuse;
 pub mod overlay;
 pub mod params;
+pub mod planes;
 pub mod props;
 pub mod services;
 
@@ -23,4 +24,4 @@ pub(crate) use checks::VIOLATION_TESTS;
 pub use checks::{host_failure, take_violations, violation};
 pub use effect::{take_unowned_messages, Effect, FrameSource, Message};
 pub use frame::Frame;
-pub use instance::{Instance, OutputSpec};
+pub use instance::{ClipPlanes, Instance, OutputSpec};

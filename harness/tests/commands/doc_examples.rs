@@ -193,6 +193,7 @@ fn stated_default(text: &str) -> Option<String> {
         match v.as_str() {
             "off" => "false".to_string(),
             "on" => "true".to_string(),
+            "empty" => String::new(),
             _ => v,
         }
     };
@@ -256,6 +257,7 @@ fn every_default_the_user_guide_states_is_the_nodes() {
                 }
                 "OfxParamTypeBoolean" => (p.ints(kOfxParamPropDefault)[0] == 1).to_string(),
                 "OfxParamTypeInteger" => p.ints(kOfxParamPropDefault)[0].to_string(),
+                "OfxParamTypeString" => p.strs(kOfxParamPropDefault)[0].clone(),
                 _ => p.doubles(kOfxParamPropDefault)[0].to_string(),
             };
             let same = match (stated.parse::<f64>(), actual.parse::<f64>()) {

@@ -260,6 +260,7 @@ pub fn overlay_bundle() -> &'static morphfx_harness::host::Bundle {
         let options = HostOptions {
             overlays: true,
             draw_suite: true,
+            multi_plane: false,
         };
         Bundle::load_with(&bundle_path(), options).expect("the bundle loads")
     })
