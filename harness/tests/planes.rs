@@ -121,6 +121,14 @@ fn set_lines(inst: &Instance<'_>) {
     inst.set_double("progress", &[0.4], None).unwrap();
 }
 
+/// A node of the planar host over a `W × H` project, with [`set_lines`].
+fn lined(plugin: &str, context: &str) -> Instance<'static> {
+    let inst = planar().instance(plugin, context).unwrap();
+    inst.set_project(W as f64, H as f64);
+    set_lines(&inst);
+    inst
+}
+
 fn spec() -> OutputSpec {
     OutputSpec {
         identity: false,
@@ -179,11 +187,7 @@ fn the_nodes_say_they_make_every_plane_of_their_source() {
 
 #[test]
 fn every_plane_equals_that_plane_warped_alone() {
-    let inst = planar()
-        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
-        .unwrap();
-    inst.set_project(W as f64, H as f64);
-    set_lines(&inst);
+    let inst = lined("net.morphfx.Warp", "OfxImageEffectContextFilter");
     connect_layers(&inst, "Source", 0.0);
     let colour_alone = inst.render(0.0, spec()).unwrap().to_image();
     let rendered = inst.render_planes(0.0, spec(), &every_plane()).unwrap();
@@ -260,11 +264,7 @@ fn every_plane_equals_that_plane_warped_alone() {
 /// the source's IDs: no ID is ever a blend of two.
 #[test]
 fn the_morph_node_never_blends_ids() {
-    let inst = planar()
-        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-        .unwrap();
-    inst.set_project(W as f64, H as f64);
-    set_lines(&inst);
+    let inst = lined("net.morphfx.Morph", "OfxImageEffectContextGeneral");
     connect_layers(&inst, "SourceA", 0.0);
     connect_layers(&inst, "SourceB", 1.0);
     let (n, id) = (&LAYERS[0], &LAYERS[2]);
@@ -313,11 +313,7 @@ fn the_morph_node_never_blends_ids() {
 /// and every other layer is the warped source.
 #[test]
 fn layers_blur_as_pictures_ids_do_not_and_diagnostics_leave_them_warped() {
-    let inst = planar()
-        .instance("net.morphfx.Warp", "OfxImageEffectContextFilter")
-        .unwrap();
-    inst.set_project(W as f64, H as f64);
-    set_lines(&inst);
+    let inst = lined("net.morphfx.Warp", "OfxImageEffectContextFilter");
     inst.set_double("progress", &[0.0], Some(0.0)).unwrap();
     inst.set_double("progress", &[1.0], Some(10.0)).unwrap();
     connect_layers(&inst, "Source", 0.0);
@@ -363,11 +359,7 @@ fn layers_blur_as_pictures_ids_do_not_and_diagnostics_leave_them_warped() {
 /// A layer Source B lacks dissolves with transparent black.
 #[test]
 fn a_layer_source_b_lacks_dissolves_with_black() {
-    let inst = planar()
-        .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
-        .unwrap();
-    inst.set_project(W as f64, H as f64);
-    set_lines(&inst);
+    let inst = lined("net.morphfx.Morph", "OfxImageEffectContextGeneral");
     connect_layers(&inst, "SourceA", 0.0);
     common::connect_textured(&inst, &[("SourceB", 1.0)], (W, H));
     inst.connect_planes("SourceB", Vec::new()).unwrap();
