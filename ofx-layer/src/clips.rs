@@ -361,18 +361,23 @@ impl Clip {
         }
     }
 
-    /// The clip's image of `plane` at `time` (the plane suite; the colour
-    /// plane as [`Clip::image`]); `None` when the host has none, which the
+    /// The clip's image of `plane` at `time`, through the plane suite where
+    /// the host is multi-planar (colour too: Natron hands a multi-planar
+    /// effect the output's colour buffer only that way), else the colour
+    /// as [`Clip::image`]; `None` when the host has none, which the
     /// extension says to take as transparent black.
     pub fn image_plane(&self, time: f64, plane: &str) -> Outcome<Option<HostImage>> {
-        if planes::is_colour(plane) {
-            return self.image(time);
-        }
-        let f = self
+        let suite = self
             .suites
             .plane
             .and_then(|s| s.clipGetImagePlane)
-            .ok_or_else(|| Failure::Failed("the host has no plane suite".into()))?;
+            .filter(|_| host::multi_planar());
+        let Some(f) = suite else {
+            if planes::is_colour(plane) {
+                return self.image(time);
+            }
+            return Err(Failure::Failed("the host has no plane suite".into()));
+        };
         let name = std::ffi::CString::new(plane)
             .map_err(|_| Failure::Failed(format!("plane {plane:?} has a NUL in its name")))?;
         let mut p: OfxPropertySetHandle = std::ptr::null_mut();

@@ -438,13 +438,8 @@ impl Instance<'_> {
             f.par = self.pixel_aspect();
             frames.push((p.clone(), Arc::new(f)));
         }
-        let colour = frames.iter().find(|(p, _)| p == planes::COLOUR);
-        *out_clip.output.locked() = colour.map(|(_, f)| f.clone());
-        *out_clip.output_planes.locked() = frames
-            .iter()
-            .filter(|(p, _)| p != planes::COLOUR)
-            .cloned()
-            .collect();
+        // Every plane, colour too, only through the plane suite (Natron's way).
+        *out_clip.output_planes.locked() = frames.clone();
         out_clip
             .props
             .set_str(kOfxImageEffectPropPixelDepth, spec.depth);

@@ -47,7 +47,10 @@ pub fn channels(plane: &str) -> Option<usize> {
     (1..=4).contains(&n).then_some(n)
 }
 
-/// The plane suite, version 1.
+/// The plane suite, version 1. While [`crate::host::Instance::render_planes`]
+/// renders, the output's colour is one of its planes, handed out only
+/// here, as Natron does for a multi-planar effect (its `clipGetImage` of
+/// the output then gives no image).
 #[repr(C)]
 #[allow(non_snake_case)] // the C struct's field name
 pub struct PlaneSuiteV1 {
@@ -106,14 +109,15 @@ unsafe extern "C" fn clip_get_image_plane(
         let name = unsafe { CStr::from_ptr(plane) }
             .to_string_lossy()
             .into_owned();
-        if name == COLOUR {
-            // SAFETY: the plugin's own arguments, passed on unchanged.
-            return unsafe { clip_get_image(clip, time, region, image) };
-        }
         // SAFETY: the plugin passes a clip handle we gave it (see `clip_of`).
         let Some(c) = (unsafe { clip_of(clip) }) else {
             return kOfxStatErrBadHandle;
         };
+        let rendering = c.output_planes.locked().iter().any(|(p, _)| p == COLOUR);
+        if name == COLOUR && !rendering {
+            // SAFETY: the plugin's own arguments, passed on unchanged.
+            return unsafe { clip_get_image(clip, time, region, image) };
+        }
         let frame = match c.plane_at(&name, time) {
             Ok(Some(f)) => f,
             // The extension: a plane the clip cannot give fails the call,
@@ -122,7 +126,9 @@ unsafe extern "C" fn clip_get_image_plane(
         };
         let scale = *c.effect().render_scale.locked();
         let props = frame.image_props(scale, time);
-        props.set_str(kOfxImageEffectPropComponents, &name);
+        if name != COLOUR {
+            props.set_str(kOfxImageEffectPropComponents, &name);
+        }
         // SAFETY: out-pointer from the plugin. The boxed set (owning the
         // frame) is released by clipReleaseImage.
         unsafe { *image = Box::into_raw(Box::new(props)) as OfxPropertySetHandle };

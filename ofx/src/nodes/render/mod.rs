@@ -312,7 +312,7 @@ fn source(effect: &EffectHandle, name: &str, time: f64) -> Outcome<Option<HostIm
     if !clip.is_connected() {
         return Ok(None);
     }
-    clip.image(time)
+    clip.image_plane(time, ofx_layer::planes::COLOUR)
 }
 
 /// The most pixels one render window may have.
