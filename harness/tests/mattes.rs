@@ -312,19 +312,8 @@ fn the_ghost_view_is_the_mean_difference_of_the_warped_sources() {
 /// Two parallel lines that swap places between A and B: at t = 0.3 the
 /// field between them turns over.
 fn swap_lines(inst: &host::Instance<'_>) {
-    inst.set_int("line_count", 2).unwrap();
     let (low, high) = ([[16.0, 18.0], [48.0, 18.0]], [[16.0, 30.0], [48.0, 30.0]]);
-    for (k, a, b) in [(1, low, high), (2, high, low)] {
-        for (end, xy) in [
-            ("a_start", a[0]),
-            ("a_end", a[1]),
-            ("b_start", b[0]),
-            ("b_end", b[1]),
-        ] {
-            inst.set_double(&format!("line{k}_{end}"), &xy, None)
-                .unwrap();
-        }
-    }
+    common::set_line_slots(inst, &[(low, high), (high, low)]);
 }
 
 /// The Jacobian determinant of an ST map at an inner pixel, by central

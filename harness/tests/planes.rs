@@ -105,19 +105,8 @@ fn connect_layers(inst: &Instance<'_>, clip: &str, seed: f32) {
 
 /// Two lines that cross over: a warp that moves every pixel differently.
 fn set_lines(inst: &Instance<'_>) {
-    inst.set_int("line_count", 2).unwrap();
     let (low, high) = ([[16.0, 18.0], [48.0, 18.0]], [[14.0, 30.0], [50.0, 33.0]]);
-    for (k, a, b) in [(1, low, high), (2, high, low)] {
-        for (end, xy) in [
-            ("a_start", a[0]),
-            ("a_end", a[1]),
-            ("b_start", b[0]),
-            ("b_end", b[1]),
-        ] {
-            inst.set_double(&format!("line{k}_{end}"), &xy, None)
-                .unwrap();
-        }
-    }
+    common::set_line_slots(inst, &[(low, high), (high, low)]);
     inst.set_double("progress", &[0.4], None).unwrap();
 }
 

@@ -213,6 +213,27 @@ pub fn connect_textured(
     }
 }
 
+/// A line pair: A's two ends, then B's.
+#[allow(dead_code)] // not every test file sets line slots
+pub type LinePair = ([[f64; 2]; 2], [[f64; 2]; 2]);
+
+/// Sets the node's line slots to `lines`.
+#[allow(dead_code)] // not every test file sets line slots
+pub fn set_line_slots(inst: &morphfx_harness::host::Instance<'_>, lines: &[LinePair]) {
+    inst.set_int("line_count", lines.len() as i32).unwrap();
+    for (k, (a, b)) in lines.iter().enumerate() {
+        for (end, xy) in [
+            ("a_start", a[0]),
+            ("a_end", a[1]),
+            ("b_start", b[0]),
+            ("b_end", b[1]),
+        ] {
+            inst.set_double(&format!("line{}_{end}", k + 1), &xy, None)
+                .unwrap();
+        }
+    }
+}
+
 /// A shot's pyramids held in memory, as the tracker asks for them.
 #[allow(dead_code)] // the tracking tests only
 pub struct InMemory(pub Vec<std::sync::Arc<morphfx::track::Pyramid>>);
