@@ -366,3 +366,25 @@ fn a_layer_source_b_lacks_dissolves_with_black() {
     let most = got.data.iter().fold(0f32, |m, v| m.max(*v));
     assert!(most > 0.4 && most <= 0.6 * 0.95 + 1e-4, "{most}");
 }
+
+/// The Mask acts on an ID layer as a switch at one half: where it is
+/// below, the source's IDs stay in place; above, the warped IDs.
+#[test]
+fn the_mask_switches_ids_whole() {
+    let inst = lined("net.morphfx.Warp", "OfxImageEffectContextFilter");
+    connect_layers(&inst, "Source", 0.0);
+    let id = &LAYERS[2];
+    let asked = [plane_of(id)];
+    let warped = inst.render_planes(0.0, spec(), &asked).unwrap()[0]
+        .1
+        .to_image();
+    for (alpha, want) in [(0.3, image(id, 0.0)), (0.7, warped)] {
+        let mask = Image::from_fn(RectI::from_size(W, H), 1, |_, _, _| alpha);
+        inst.connect("Mask", still(mask)).unwrap();
+        let got = inst.render_planes(0.0, spec(), &asked).unwrap()[0]
+            .1
+            .to_image();
+        assert_eq!(got.data, want.data, "mask {alpha}");
+    }
+    inst.disconnect("Mask").unwrap();
+}
