@@ -106,10 +106,56 @@ fn prepare(dir: &Path, run: &dyn Fn(&[&str])) {
         let path = format!("docs/examples/{example}.morph.json");
         std::fs::copy(root().join(&path), dir.join(&path)).unwrap();
     }
+    // An object-ID pass as flat colours, one per 40-px block.
+    common::colour_plate(&dir.join("ids.exr"), 320, 240, |p| id_colour(p.x, p.y));
     // The real photograph the user guide's suggestions are shown on.
     let venice = "harness/tests/data/venice.exr";
     std::fs::create_dir_all(dir.join("harness/tests/data")).unwrap();
     std::fs::copy(root().join(venice), dir.join(venice)).unwrap();
+}
+
+/// The flat colour of the ID block holding canonical position (x, y).
+fn id_colour(x: f64, y: f64) -> [f32; 3] {
+    const PALETTE: [[f32; 3]; 6] = [
+        [0.9, 0.2, 0.2],
+        [0.2, 0.7, 0.3],
+        [0.2, 0.3, 0.9],
+        [0.9, 0.8, 0.2],
+        [0.7, 0.3, 0.8],
+        [0.2, 0.8, 0.8],
+    ];
+    let k = (x / 40.0) as usize + 3 * (y / 40.0) as usize;
+    PALETTE[k % PALETTE.len()]
+}
+
+/// The user guide's ID pictures: nearest keeps every pixel one of the
+/// source's colours; bilinear makes colours no block has along borders.
+fn check_id_pictures(dir: &Path) {
+    let palette: Vec<[u8; 3]> = (0..6)
+        .map(|k| {
+            let c = id_colour(40.0 * (k % 3) as f64 + 1.0, 40.0 * (k / 3) as f64 + 1.0);
+            c.map(|v| (morphfx_harness::io::linear_to_srgb(v) * 255.0).round() as u8)
+        })
+        .collect();
+    let foreign = |name: &str| {
+        let img = image::open(dir.join(name)).unwrap().to_rgb8();
+        img.pixels()
+            .filter(|p| {
+                !palette
+                    .iter()
+                    .any(|c| c.iter().zip(p.0).all(|(a, b)| a.abs_diff(b) <= 1))
+            })
+            .count()
+    };
+    assert_eq!(
+        foreign("ids-nearest.png"),
+        0,
+        "nearest: only the source's colours"
+    );
+    assert!(
+        foreign("ids-bilinear.png") > 500,
+        "bilinear: blended borders"
+    );
 }
 
 #[test]
@@ -154,6 +200,7 @@ fn every_documented_command_runs_and_the_pictures_are_what_it_draws() {
         }
     }
     assert!(ran >= 15, "only {ran} documented commands found");
+    check_id_pictures(&d);
     let bless = std::env::var_os("MORPHFX_BLESS_DOC_IMAGES").is_some();
     let images = root().join("docs/images");
     for entry in std::fs::read_dir(&images).unwrap() {
