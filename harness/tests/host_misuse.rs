@@ -14,8 +14,12 @@ mod common;
 use morphfx::geom::RectI;
 use morphfx::image::Image;
 use morphfx_harness::host::misuse::{arm, Armed, Misuse};
+use morphfx_harness::host::planes;
 use morphfx_harness::host::props::PropertySet;
-use morphfx_harness::host::{take_unowned_messages, Bundle, Frame, Instance, Message, OutputSpec};
+use morphfx_harness::host::{
+    take_unowned_messages, Bundle, ErrorKind, Frame, FrameSource, HostOptions, Instance, Message,
+    OutputSpec,
+};
 use openfx::sys::generic::core::*;
 use openfx::sys::generic::property::*;
 use openfx::sys::image_effect_v1::draw_suite::kOfxDrawSuite;
@@ -220,6 +224,44 @@ fn arguments_of_the_wrong_type_or_size_are_refused_naming_the_property() {
         );
     }
     assert_eq!(picture(&inst).data, good.data, "the instance is unharmed");
+}
+
+/// A plane whose images a host says have components no plane has (five
+/// channels, where Natron's planes have one to four) is refused as bad
+/// input naming the clip and the components, not rendered.
+#[test]
+fn a_plane_with_components_no_plane_has_is_refused() {
+    const FIVE: &str =
+        "NatronOfxImageComponentsPlaneName_N_Channel_a_Channel_b_Channel_c_Channel_d_Channel_e";
+    let armed = arm(&[Misuse::TamperImage("Source", |p| {
+        let planar = p
+            .str(kOfxImageEffectPropComponents)
+            .is_some_and(|c| c.starts_with("NatronOfx"));
+        if planar {
+            p.set_str(kOfxImageEffectPropComponents, FIVE);
+        }
+    })]);
+    let options = HostOptions {
+        multi_plane: true,
+        ..HostOptions::default()
+    };
+    let b = Bundle::load_with(&bundle_path(), options).expect("the bundle loads");
+    let inst = warp(&b);
+    let n = planes::plane("N", &["X", "Y", "Z"]);
+    let frame = Frame::from_float_image(Image::new(RectI::from_size(32, 24), 3));
+    let source: Arc<dyn FrameSource> = Arc::new(Still(Arc::new(frame)));
+    inst.connect_planes("Source", vec![(n.clone(), source)])
+        .unwrap();
+    let err = inst
+        .render_planes(0.0, OutputSpec::default(), &[planes::COLOUR.to_owned(), n])
+        .expect_err("the render was refused");
+    assert_eq!(err.kind, ErrorKind::BadInput, "{}", err.message);
+    assert!(
+        err.message.contains("clip Source") && err.message.contains(FIVE),
+        "{}",
+        err.message
+    );
+    drop(armed);
 }
 
 /// Renders with `misuse` armed on a fresh host: the error's text.

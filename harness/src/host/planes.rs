@@ -129,6 +129,7 @@ unsafe extern "C" fn clip_get_image_plane(
         if name != COLOUR {
             props.set_str(kOfxImageEffectPropComponents, &name);
         }
+        super::misuse::tamper_image(&c.name, &props);
         // SAFETY: out-pointer from the plugin. The boxed set (owning the
         // frame) is released by clipReleaseImage.
         unsafe { *image = Box::into_raw(Box::new(props)) as OfxPropertySetHandle };
