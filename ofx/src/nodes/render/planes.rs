@@ -12,7 +12,7 @@ use ofx_layer::planes::{self, ClipPlanes};
 use ofx_layer::{Failure, Outcome, Reply};
 
 use crate::nodes::kind::{MASK_CLIP, OUTPUT_CLIP, TIMING_CLIP};
-use crate::nodes::params::Settings;
+use crate::nodes::params::{Reader, Settings, OFFSET_A};
 use crate::nodes::state::NodeState;
 
 /// `GetClipComponents`: the output makes every plane Source A has, colour
@@ -24,7 +24,8 @@ pub fn clip_planes(
     time: f64,
     out: &mut ClipPlanes,
 ) -> Outcome<Reply> {
-    let settings = Settings::read(node.params(), time, node.kind);
+    // Hosts ask before every render: read the one param the answer needs.
+    let offset_a = Reader::new(node.params(), node.kind, time).int(&OFFSET_A);
     let (a, b) = node.kind.source_clips(node.context);
     let present = |name: &str| -> Outcome<Vec<String>> {
         let clip = effect.clip(name)?;
@@ -48,7 +49,7 @@ pub fn clip_planes(
     }
     out.set(MASK_CLIP, vec![planes::COLOUR.to_owned()]);
     out.set(OUTPUT_CLIP, made);
-    out.pass_through(a, time + settings.offset_a as f64);
+    out.pass_through(a, time + offset_a as f64);
     Ok(Reply::Done)
 }
 
