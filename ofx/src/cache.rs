@@ -140,6 +140,18 @@ impl Key {
     pub fn of(parts: &impl Debug) -> Key {
         Key(format!("{parts:?}").into())
     }
+
+    /// The key of `base`'s inputs with `parts` besides: a render's inputs
+    /// (a scene's worth of floats, the costly part to print) printed once
+    /// and shared by its maps. `base`'s length leads, so where it ends is
+    /// never in doubt.
+    pub fn with(base: &Key, parts: &impl Debug) -> Key {
+        use std::fmt::Write;
+        let mut text = String::with_capacity(base.0.len() + 64);
+        // Writing to a String cannot fail.
+        let _ = write!(text, "{}:{}|{parts:?}", base.0.len(), base.0);
+        Key(text.into())
+    }
 }
 
 impl<T: Weigh + Send + Sync + 'static> Cache<T> {
@@ -327,6 +339,19 @@ mod tests {
             1,
             "made again"
         );
+    }
+
+    /// A key built on a base differs with either part, and where the base
+    /// ends is never in doubt.
+    #[test]
+    fn keys_with_a_base_tell_apart_both_parts() {
+        let (a, b) = (Key::of(&"x"), Key::of(&"x|1"));
+        assert_eq!(Key::with(&a, &1), Key::with(&Key::of(&"x"), &1));
+        assert_ne!(Key::with(&a, &1), Key::with(&a, &2));
+        assert_ne!(Key::with(&a, &1), Key::with(&b, &1));
+        // Text that would read the same without the base's length.
+        let (short, long) = (Key(Arc::from("ab")), Key(Arc::from("ab|1")));
+        assert_ne!(Key::with(&short, &"1|2"), Key::with(&long, &"2"));
     }
 
     /// Keys differ wherever their inputs' bits do, however close the values.

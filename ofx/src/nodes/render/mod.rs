@@ -541,7 +541,9 @@ fn prepare<'r>(
         View::Folds => RectI::new(w.x1 - 1, w.y1 - 1, w.x2 + 1, w.y2 + 1),
         _ => w,
     };
-    let map = |side| map(instance, request, side, window);
+    // The inputs' key, printed once for both maps and the weights.
+    let inputs_key = Key::of(&request.inputs);
+    let map = |side| map(instance, request, &inputs_key, side, window);
     // Weighted implies the Morph view of the Morph node: both maps drawn.
     let map_a = (needs_a(view) && by_map)
         .then(|| map(Side::A))
@@ -550,7 +552,7 @@ fn prepare<'r>(
         .then(|| map(Side::B))
         .transpose()?;
     let weights = match (weighted, &map_a, &map_b) {
-        (true, Some(ma), Some(mb)) => Some(weights(instance, request, ma, mb)?),
+        (true, Some(ma), Some(mb)) => Some(weights(instance, request, &inputs_key, ma, mb)?),
         _ => None,
     };
     let rates = match view {
@@ -587,14 +589,16 @@ fn bad_input(e: morphfx::Error) -> Failure {
 /// The map of `side`'s warp over the render window, from the cache or made.
 /// Maps cover the render window, never more: a tile costs its own pixels,
 /// and an infinite region of definition costs nothing extra.
+/// `inputs_key` is [`Key::of`] the request's inputs.
 fn map(
     instance: &NodeState,
     request: &Request,
+    inputs_key: &Key,
     side: Side,
     window: RectI,
 ) -> Outcome<Arc<WarpMap>> {
     let (inputs, scale) = (&request.inputs, request.out_scale);
-    let key = Key::of(&(inputs, side, window, scale));
+    let key = Key::with(inputs_key, &(side, window, scale));
     if inputs.warp.method() == Method::Field && request.interactive && !request.sequential {
         return field_map(instance, request, side, window, key);
     }
@@ -649,11 +653,12 @@ fn field_map(
 fn weights(
     instance: &NodeState,
     request: &Request,
+    inputs_key: &Key,
     ma: &WarpMap,
     mb: &WarpMap,
 ) -> Outcome<Arc<transition::Weights>> {
     let inputs = &request.inputs;
-    let key = Key::of(&(inputs, "weights", ma.window, request.out_scale));
+    let key = Key::with(inputs_key, &("weights", ma.window, request.out_scale));
     instance.weights.get_or_compute(key, || {
         let colour = inputs
             .warp
