@@ -545,12 +545,17 @@ fn prepare<'r>(
     let inputs_key = Key::of(&request.inputs);
     let map = |side| map(instance, request, &inputs_key, side, window);
     // Weighted implies the Morph view of the Morph node: both maps drawn.
-    let map_a = (needs_a(view) && by_map)
-        .then(|| map(Side::A))
-        .transpose()?;
-    let map_b = (needs_b(kind, view) && by_map)
-        .then(|| map(Side::B))
-        .transpose()?;
+    // Both sides at once: a redo after a drag is mostly waiting on memory,
+    // and two of them overlap their waits.
+    let (map_a, map_b) = rayon::join(
+        || (needs_a(view) && by_map).then(|| map(Side::A)).transpose(),
+        || {
+            (needs_b(kind, view) && by_map)
+                .then(|| map(Side::B))
+                .transpose()
+        },
+    );
+    let (map_a, map_b) = (map_a?, map_b?);
     let weights = match (weighted, &map_a, &map_b) {
         (true, Some(ma), Some(mb)) => Some(weights(instance, request, &inputs_key, ma, mb)?),
         _ => None,
