@@ -69,6 +69,10 @@ pub(crate) struct Taps<'a, T> {
     base: i32,
     /// Samples from one row to the next row up.
     stride: i32,
+    /// `stride`'s size, and whether the row up lies lower in the buffer
+    /// (a host's image stored top row first): see [`Self::rows_at`].
+    span: u32,
+    flipped: bool,
     /// Samples per pixel and per row, interleaved: a pixel's offset from
     /// `base` is the sum of a pair of its index (relative to the corner)
     /// times these. All `i32`: buffers this path takes are shorter than
@@ -120,6 +124,8 @@ impl<'a, T: Sample> Taps<'a, T> {
             data,
             base: layout.base as i32,
             stride,
+            span: stride.unsigned_abs(),
+            flipped: stride < 0,
             step: i32x8::new([4, stride, 4, stride, 4, stride, 4, stride]),
             scale: pairs(scale.x as f32, scale.y as f32),
             lo: pairs((b.x1 + below) as f32, (b.y1 + below) as f32),
@@ -188,6 +194,28 @@ impl<'a, T: Sample> Taps<'a, T> {
         }
     }
 
+    /// The eight samples from index `at` (two pixels of a tap row) and
+    /// the eight a row up, with one bounds check on the samples between
+    /// them instead of one per load: the offsets of both within it are
+    /// known to the compiler (each 0 or `span`, and `span` a `u32`).
+    #[inline(always)]
+    fn rows_at(&self, at: i32) -> (f32x8, f32x8) {
+        let span = self.span as usize;
+        let lower = match self.flipped {
+            true => at.wrapping_add(self.stride),
+            false => at,
+        };
+        // Indices inside the buffer, which fits `i32`; through `u32` the
+        // slice end cannot overflow.
+        let lower = lower as u32 as usize;
+        let both = &self.data[lower..lower + span + 8];
+        let (below, above) = match self.flipped {
+            true => (span, 0),
+            false => (0, span),
+        };
+        (T::load8(&both[below..]), T::load8(&both[above..]))
+    }
+
     /// The eight samples from index `at`: two pixels of a tap row.
     #[inline(always)]
     fn load(&self, at: i32) -> f32x8 {
@@ -207,11 +235,7 @@ impl<'a, T: Sample> Taps<'a, T> {
         // Indices inside the buffer, which fits `i32`; through `u32` the
         // slice end cannot overflow, so one check per load remains.
         let at = self.base + l.offsets[x] + l.offsets[y];
-        let load = |at: i32| {
-            let at = at as u32 as usize;
-            T::load8(&self.data[at..at + 8])
-        };
-        let (below, above) = (load(at), load(at + self.stride));
+        let (below, above) = self.rows_at(at);
         // Each row's pair of horizontal neighbours blended vertically, then
         // the two halves horizontally.
         let v = (above - below)
@@ -228,7 +252,7 @@ impl<'a, T: Sample> Taps<'a, T> {
     fn pixel_pair(&self, l: &Located, k: usize) -> f32x8 {
         let vertical = |k: usize| {
             let at = self.base + l.offsets[2 * k] + l.offsets[2 * k + 1];
-            let (below, above) = (self.load(at), self.load(at + self.stride));
+            let (below, above) = self.rows_at(at);
             (above - below)
                 .mul_add(f32x8::splat(l.t[2 * k + 1]), below)
                 .to_array()

@@ -142,7 +142,8 @@ fn straight_alpha_filtering_does_not_bleed_transparent_colour() {
 
 /// The direct float RGBA path addresses taps from the buffer's origin and
 /// stride: a top-down, padded buffer with an offset must give exactly what a
-/// packed one gives, and both what each position's bilinear blend is.
+/// packed one gives, and both what each position's bilinear blend (or
+/// Catmull-Rom sum) is.
 #[test]
 fn direct_float_rgba_sampling_reads_any_layout_exactly() {
     let bounds = RectI::new(-7, 3, 30, 25);
@@ -166,8 +167,12 @@ fn direct_float_rgba_sampling_reads_any_layout_exactly() {
     };
     let flipped = ImageView::new(&flipped, layout).unwrap();
     let positions = crate::testing::awkward_positions(bounds, 1003, 5);
-    for edge in [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror] {
-        let sampler = |view| Sampler::new(view, PixelScale::UNIT, Filter::Bilinear, edge, true);
+    let filters = [Filter::Bilinear, Filter::Bicubic];
+    let cases = filters
+        .into_iter()
+        .flat_map(|f| [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror].map(|edge| (f, edge)));
+    for (filter, edge) in cases {
+        let sampler = |view| Sampler::new(view, PixelScale::UNIT, filter, edge, true);
         let (packed, top_down) = (sampler(img.view()), sampler(flipped));
         let mut want = vec![[0f32; 4]; positions.len()];
         let mut got = want.clone();
@@ -175,12 +180,13 @@ fn direct_float_rgba_sampling_reads_any_layout_exactly() {
         top_down.sample_row(&positions, &mut got);
         for ((p, g), w) in positions.iter().zip(&got).zip(&want) {
             let same = g.iter().zip(w).all(|(g, w)| g.to_bits() == w.to_bits());
-            assert!(same, "{edge:?} at {p:?}: {g:?} vs {w:?}");
+            assert!(same, "{filter:?} {edge:?} at {p:?}: {g:?} vs {w:?}");
             let mut one = [0f32; 4];
             packed.sample(p[0], p[1], &mut one);
             for c in 0..4 {
                 let ok = (g[c] - one[c]).abs() <= 1e-5 || (g[c].is_nan() && one[c].is_nan());
-                assert!(ok, "{edge:?} at {p:?}: {g:?} vs one sample {one:?}");
+                let at = format!("{filter:?} {edge:?} at {p:?}");
+                assert!(ok, "{at}: {g:?} vs one sample {one:?}");
             }
         }
     }
