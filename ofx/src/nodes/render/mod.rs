@@ -545,8 +545,9 @@ fn prepare<'r>(
     let inputs_key = Key::of(&request.inputs);
     let map = |side| map(instance, request, &inputs_key, side, window);
     // Weighted implies the Morph view of the Morph node: both maps drawn.
-    // Both sides at once: a redo after a drag is mostly waiting on memory,
-    // and two of them overlap their waits.
+    // Both sides at once: a redo after a drag spends much of its time
+    // waiting (on memory the last draw evicted, on the pool waking), and
+    // two of them overlap their waits.
     let (map_a, map_b) = rayon::join(
         || (needs_a(view) && by_map).then(|| map(Side::A)).transpose(),
         || {
