@@ -8,101 +8,82 @@ use wide::f32x8;
 use super::lines::LinePair;
 use super::weight::{Exponent, Weight};
 
+/// The lines, each one's constants together in one cache line: the kernel
+/// broadcasts them from one base pointer, where fifteen separate arrays
+/// left too few registers for their pointers (reloaded from the stack at
+/// every line).
 #[derive(Debug, Clone, Default)]
 pub(super) struct Lines {
-    // Destination line P→Q, its direction d and 1/|d|², 1/|d|.
-    px: Vec<f32>,
-    py: Vec<f32>,
-    qx: Vec<f32>,
-    qy: Vec<f32>,
-    dx: Vec<f32>,
-    dy: Vec<f32>,
-    inv_len2: Vec<f32>,
-    inv_len: Vec<f32>,
-    // Source line P' and its direction e' and unit normal n'.
-    spx: Vec<f32>,
-    spy: Vec<f32>,
-    ex: Vec<f32>,
-    ey: Vec<f32>,
-    nx: Vec<f32>,
-    ny: Vec<f32>,
-    /// `length^p` of the destination line.
-    len_p: Vec<f32>,
+    lines: Vec<Line>,
     a: f32,
     exponent: Option<Exponent>,
 }
 
+/// One line's constants.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(64))]
+struct Line {
+    // Destination line P→Q, its direction d and 1/|d|², 1/|d|.
+    px: f32,
+    py: f32,
+    qx: f32,
+    qy: f32,
+    dx: f32,
+    dy: f32,
+    inv_len2: f32,
+    inv_len: f32,
+    // Source line P' and its direction e' and unit normal n'.
+    spx: f32,
+    spy: f32,
+    ex: f32,
+    ey: f32,
+    nx: f32,
+    ny: f32,
+    /// `length^p` of the destination line.
+    len_p: f32,
+}
+
+impl Line {
+    fn new(pair: &LinePair, weight: &Weight) -> Self {
+        let (p, q) = pair.dst;
+        let (ps, qs) = pair.src;
+        let d = q - p;
+        let e = qs - ps;
+        let n = e.perp() / e.length();
+        Line {
+            px: p.x as f32,
+            py: p.y as f32,
+            qx: q.x as f32,
+            qy: q.y as f32,
+            dx: d.x as f32,
+            dy: d.y as f32,
+            inv_len2: (1.0 / d.length_squared()) as f32,
+            inv_len: (1.0 / d.length()) as f32,
+            spx: ps.x as f32,
+            spy: ps.y as f32,
+            ex: e.x as f32,
+            ey: e.y as f32,
+            nx: n.x as f32,
+            ny: n.y as f32,
+            len_p: d.length().powf(weight.p) as f32,
+        }
+    }
+}
+
 impl Lines {
     pub fn new(pairs: &[LinePair], weight: &Weight) -> Self {
-        let n = pairs.len();
-        let v = || Vec::with_capacity(n);
-        let mut l = Lines {
-            px: v(),
-            py: v(),
-            qx: v(),
-            qy: v(),
-            dx: v(),
-            dy: v(),
-            inv_len2: v(),
-            inv_len: v(),
-            spx: v(),
-            spy: v(),
-            ex: v(),
-            ey: v(),
-            nx: v(),
-            ny: v(),
-            len_p: v(),
+        Lines {
+            lines: pairs.iter().map(|pair| Line::new(pair, weight)).collect(),
             a: weight.a as f32,
             exponent: Some(weight.exponent()),
-        };
-        for pair in pairs {
-            let (p, q) = pair.dst;
-            let (ps, qs) = pair.src;
-            let d = q - p;
-            let e = qs - ps;
-            let n = e.perp() / e.length();
-            l.px.push(p.x as f32);
-            l.py.push(p.y as f32);
-            l.qx.push(q.x as f32);
-            l.qy.push(q.y as f32);
-            l.dx.push(d.x as f32);
-            l.dy.push(d.y as f32);
-            l.inv_len2.push((1.0 / d.length_squared()) as f32);
-            l.inv_len.push((1.0 / d.length()) as f32);
-            l.spx.push(ps.x as f32);
-            l.spy.push(ps.y as f32);
-            l.ex.push(e.x as f32);
-            l.ey.push(e.y as f32);
-            l.nx.push(n.x as f32);
-            l.ny.push(n.y as f32);
-            l.len_p.push(d.length().powf(weight.p) as f32);
         }
-        l
     }
 
-    /// The lines at `indices` of `self`, into `out` (reusing its buffers):
+    /// The lines at `indices` of `self`, into `out` (reusing its buffer):
     /// a block's near or far set without recomputing lengths and powers.
     pub fn select_into(&self, indices: &[usize], out: &mut Lines) {
-        for (dst, src) in [
-            (&mut out.px, &self.px),
-            (&mut out.py, &self.py),
-            (&mut out.qx, &self.qx),
-            (&mut out.qy, &self.qy),
-            (&mut out.dx, &self.dx),
-            (&mut out.dy, &self.dy),
-            (&mut out.inv_len2, &self.inv_len2),
-            (&mut out.inv_len, &self.inv_len),
-            (&mut out.spx, &self.spx),
-            (&mut out.spy, &self.spy),
-            (&mut out.ex, &self.ex),
-            (&mut out.ey, &self.ey),
-            (&mut out.nx, &self.nx),
-            (&mut out.ny, &self.ny),
-            (&mut out.len_p, &self.len_p),
-        ] {
-            dst.clear();
-            dst.extend(indices.iter().map(|&i| src[i]));
-        }
+        out.lines.clear();
+        out.lines.extend(indices.iter().map(|&i| self.lines[i]));
         out.a = self.a;
         out.exponent = self.exponent;
     }
@@ -256,22 +237,22 @@ impl Lines {
             w: mut ws,
         } = init;
         let s = f32x8::splat;
-        for k in 0..self.px.len() {
-            let rx = x - s(self.px[k]);
-            let ry = y - s(self.py[k]);
-            let (dx, dy) = (s(self.dx[k]), s(self.dy[k]));
-            let u = (rx * dx + ry * dy) * s(self.inv_len2[k]);
-            let v = (ry * dx - rx * dy) * s(self.inv_len[k]);
-            let tx = s(self.spx[k]) + u * s(self.ex[k]) + v * s(self.nx[k]);
-            let ty = s(self.spy[k]) + u * s(self.ey[k]) + v * s(self.ny[k]);
-            let (qx, qy) = (x - s(self.qx[k]), y - s(self.qy[k]));
+        for l in &self.lines {
+            let rx = x - s(l.px);
+            let ry = y - s(l.py);
+            let (dx, dy) = (s(l.dx), s(l.dy));
+            let u = rx.mul_add(dx, ry * dy) * s(l.inv_len2);
+            let v = ry.mul_sub(dx, rx * dy) * s(l.inv_len);
+            let tx = u.mul_add(s(l.ex), v.mul_add(s(l.nx), s(l.spx)));
+            let ty = u.mul_add(s(l.ey), v.mul_add(s(l.ny), s(l.spy)));
+            let (qx, qy) = (x - s(l.qx), y - s(l.qy));
             let d2 = u.simd_lt(zero).select(
-                rx * rx + ry * ry,
-                u.simd_gt(one).select(qx * qx + qy * qy, v * v),
+                rx.mul_add(rx, ry * ry),
+                u.simd_gt(one).select(qx.mul_add(qx, qy * qy), v * v),
             );
-            let w = pow(s(self.len_p[k]) / (a + d2.sqrt()));
-            sx += (tx - x) * w;
-            sy += (ty - y) * w;
+            let w = pow(s(l.len_p) / (a + d2.sqrt()));
+            sx = (tx - x).mul_add(w, sx);
+            sy = (ty - y).mul_add(w, sy);
             ws += w;
         }
         Sums {
