@@ -37,6 +37,15 @@ pub(super) const PADDED: usize = SAMPLES.div_ceil(8) * 8;
 /// top of the far field's own error checked then.
 pub(super) const SHARE: f32 = 0.5;
 
+/// A block's lag and where it is sampled: the samples are the block's for
+/// as long as the map is (same window, same scale), so they are found once,
+/// when the map is made, not at every redo.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Tracked {
+    pub lag: Lag,
+    pub samples: Samples,
+}
+
 /// One block's lag.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Lag {
@@ -93,6 +102,7 @@ type Place = ((usize, usize), (f32, f32));
 /// far line's is, the centre alone would see almost nothing). The check
 /// points are all three kinds: the cells' centres, then the centres of
 /// their edges across, then those up, each row by row.
+#[derive(Debug, Clone)]
 pub(super) struct Samples {
     /// Positions, padded to whole lanes.
     pub xs: [f32; PADDED],
@@ -116,6 +126,21 @@ const KINDS: [((i32, i32), (f32, f32)); 3] = [
     ((0, SPACING / 2), (0.0, 0.5)),
 ];
 
+impl Default for Samples {
+    fn default() -> Self {
+        Samples {
+            xs: [0.0; PADDED],
+            ys: [0.0; PADDED],
+            len: 0,
+            nodes: 0,
+            nx: 0,
+            ny: 0,
+            first: (0, 0),
+            last: (0, 0),
+        }
+    }
+}
+
 impl Samples {
     /// The samples of `block` at `scale`.
     pub fn of(block: RectI, scale: PixelScale) -> Self {
@@ -133,32 +158,26 @@ impl Samples {
         // Every sample lies on a half-spacing lattice: its coordinates,
         // once per column and row.
         let half = SPACING / 2;
-        let column = |k: i32| (scale.pixel_centre(block.x1 + k * half, 0).x) as f32;
-        let row = |k: i32| (scale.pixel_centre(0, block.y1 + k * half).y) as f32;
-        let columns: Vec<f32> = (0..2 * nx as i32).map(column).collect();
-        let rows: Vec<f32> = (0..2 * s.ny as i32).map(row).collect();
-        let push = |s: &mut Samples, (a2, c2): (usize, usize)| {
-            (s.xs[s.len], s.ys[s.len]) = (columns[a2], rows[c2]);
-            s.len += 1;
-        };
-        for n in 0..nodes {
-            push(&mut s, (2 * (n % nx), 2 * (n / nx)));
+        let (mut columns, mut rows) = ([0f32; 2 * NODES_ACROSS], [0f32; 2 * NODES_ACROSS]);
+        for (k, c) in columns[..2 * nx].iter_mut().enumerate() {
+            *c = scale.pixel_centre(block.x1 + k as i32 * half, 0).x as f32;
         }
-        for ((di, dj), _) in KINDS {
-            let (da, dc) = (usize::from(di > 0), usize::from(dj > 0));
-            for c in 0..s.ny - dc {
-                for a in 0..nx - da {
-                    push(&mut s, (2 * a + da, 2 * c + dc));
-                }
-            }
+        for (k, r) in rows[..2 * s.ny].iter_mut().enumerate() {
+            *r = scale.pixel_centre(0, block.y1 + k as i32 * half).y as f32;
         }
+        let mut len = 0;
+        for ((a2, c2), _) in s.points() {
+            (s.xs[len], s.ys[len]) = (columns[a2], rows[c2]);
+            len += 1;
+        }
+        s.len = len;
         s
     }
 
-    /// The pixel sample `n` reads its sums from (samples past the block's
-    /// far edges read its last row or column).
-    fn pixel(&self, n: usize) -> (i32, i32) {
-        let ((a2, c2), _) = self.lattice(n);
+    /// The pixel a sample at `(a2, c2)` on the half-spacing lattice reads
+    /// its sums from (samples past the block's far edges read its last row
+    /// or column).
+    fn pixel(&self, (a2, c2): (usize, usize)) -> (i32, i32) {
         let half = SPACING / 2;
         let (i, j) = (
             self.first.0 + a2 as i32 * half,
@@ -167,34 +186,31 @@ impl Samples {
         (i.min(self.last.0), j.min(self.last.1))
     }
 
-    /// Sample `n` on the half-spacing lattice (across, up), and for a
-    /// check point its place in a grid cell.
-    fn lattice(&self, n: usize) -> ((usize, usize), Option<Place>) {
+    /// Each sample in order: where it lies on the half-spacing lattice
+    /// (across, up), and for a check point its place in a grid cell. In
+    /// order, not sample by sample: finding a sample's place on its own
+    /// takes divisions, which made up a tenth of a redo.
+    fn points(&self) -> impl Iterator<Item = ((usize, usize), Option<Place>)> {
         let (nx, ny) = (self.nx, self.ny);
-        if n < self.nodes {
-            return ((2 * (n % nx), 2 * (n / nx)), None);
-        }
-        let mut k = n - self.nodes;
-        for ((di, dj), at) in KINDS {
+        let nodes = (0..ny).flat_map(move |c| (0..nx).map(move |a| ((2 * a, 2 * c), None)));
+        let checks = KINDS.into_iter().flat_map(move |((di, dj), at)| {
             let (da, dc) = (usize::from(di > 0), usize::from(dj > 0));
-            let across = nx - da;
-            let count = across * (ny - dc);
-            if k < count {
-                let (a, c) = (k % across, k / across);
-                // A point on the grid's last row or column lies on the far
-                // edge of the cell before it.
-                let cell = (a.min(nx - 2), c.min(ny - 2));
-                let at = (at.0 + (a - cell.0) as f32, at.1 + (c - cell.1) as f32);
-                return ((2 * a + da, 2 * c + dc), Some((cell, at)));
-            }
-            k -= count;
-        }
-        unreachable!("sample {n} of {}", self.len)
+            (0..ny - dc).flat_map(move |c| {
+                (0..nx - da).map(move |a| {
+                    // A point on the grid's last row or column lies on the
+                    // far edge of the cell before it.
+                    let cell = (a.min(nx - 2), c.min(ny - 2));
+                    let at = (at.0 + (a - cell.0) as f32, at.1 + (c - cell.1) as f32);
+                    ((2 * a + da, 2 * c + dc), Some((cell, at)))
+                })
+            })
+        });
+        nodes.chain(checks)
     }
 
     /// The check points' places, in order.
-    fn checks(&self) -> impl Iterator<Item = Place> + '_ {
-        (self.nodes..self.len).filter_map(|n| self.lattice(n).1)
+    fn checks(&self) -> impl Iterator<Item = Place> {
+        self.points().filter_map(|(_, place)| place)
     }
 }
 
@@ -210,8 +226,8 @@ impl Lag {
     /// Notes what the block's pixels in `band` hold at `samples`, after
     /// they were written.
     pub fn look(&mut self, band: &Band, samples: &Samples) {
-        for (n, seen) in self.seen.0[..samples.len].iter_mut().enumerate() {
-            let (i, j) = samples.pixel(n);
+        for (seen, (at, _)) in self.seen.0[..samples.len].iter_mut().zip(samples.points()) {
+            let (i, j) = samples.pixel(at);
             let (p, w) = band.at(i, j);
             *seen = [p[0], p[1], w];
         }

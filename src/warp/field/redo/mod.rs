@@ -38,7 +38,7 @@ use crate::image::WarpMap;
 mod lag;
 mod swap;
 
-use lag::{Lag, Samples, Take};
+use lag::{Lag, Samples, Take, Tracked};
 use swap::{swap_terms, RowChange};
 
 /// Blocks closer than this (pixels) to a moved line, before or after,
@@ -61,7 +61,7 @@ pub struct FieldMap {
     /// `Σ w` per pixel (empty for an identity map).
     weights: Vec<f32>,
     /// Per block of the evaluation, what redos have not written yet.
-    lags: Vec<Lag>,
+    lags: Vec<Tracked>,
     pairs: Vec<LinePair>,
     weight: Weight,
     evaluation: Evaluation,
@@ -78,7 +78,7 @@ impl FieldMap {
     pub fn memory_bytes(&self) -> usize {
         self.map.memory_bytes()
             + self.weights.len() * std::mem::size_of::<f32>()
-            + self.lags.len() * std::mem::size_of::<Lag>()
+            + self.lags.len() * std::mem::size_of::<Tracked>()
     }
 
     /// How many redos this map is from a full evaluation (0: it is one).
@@ -91,7 +91,7 @@ impl FieldMap {
 struct Buffers {
     pos: Vec<[f32; 2]>,
     weights: Vec<f32>,
-    lags: Vec<Lag>,
+    lags: Vec<Tracked>,
     redos: u32,
 }
 
@@ -165,7 +165,12 @@ impl FieldWarp {
         Setup::new(self, window, scale, tolerance)
     }
 
-    fn kept(&self, setup: &Setup, pos: Vec<[f32; 2]>, b: (Vec<f32>, Vec<Lag>, u32)) -> FieldMap {
+    fn kept(
+        &self,
+        setup: &Setup,
+        pos: Vec<[f32; 2]>,
+        b: (Vec<f32>, Vec<Tracked>, u32),
+    ) -> FieldMap {
         let map = match self.identity {
             true => WarpMap::identity(setup.window, setup.scale),
             false => WarpMap::new(setup.window, setup.scale, pos),
@@ -189,11 +194,12 @@ impl FieldWarp {
         let area = setup.window.area();
         let mut pos = vec![[0f32; 2]; area];
         let mut weights = vec![0f32; area];
-        let mut lags = vec![Lag::default(); setup.block_count()];
+        let mut lags = vec![Tracked::default(); setup.block_count()];
         setup.each_band(&mut pos, Some(&mut weights), &mut lags, |band, lags| {
-            for (k, lag) in lags.iter_mut().enumerate() {
+            for (k, tracked) in lags.iter_mut().enumerate() {
                 band.block(k).fill();
-                lag.look(band, &Samples::of(band.rect(k), band.setup.scale));
+                tracked.samples = Samples::of(band.rect(k), band.setup.scale);
+                tracked.lag.look(band, &tracked.samples);
             }
         });
         self.kept(setup, pos, (weights, lags, 0))
@@ -268,29 +274,24 @@ impl Moved {
     /// terms swapped in each block as [`Self::plan`] says, the pixels whose
     /// sums cannot take the swap evaluated exactly, and a block with many
     /// of them evaluated afresh.
-    fn redo(&self, band: &mut Band, lags: &mut [Lag]) {
-        let scale = band.setup.scale;
-        let samples: Vec<Samples> = (0..lags.len())
-            .map(|k| Samples::of(band.rect(k), scale))
-            .collect();
-        let steps = lags
-            .iter_mut()
-            .zip(&samples)
-            .enumerate()
-            .map(|(k, (lag, samples))| {
-                Step::of(self.plan(band, k, lag, samples), band.rect(k).width())
-            });
+    fn redo(&self, band: &mut Band, lags: &mut [Tracked]) {
+        let steps = lags.iter_mut().enumerate().map(|(k, t)| {
+            Step::of(
+                self.plan(band, k, &mut t.lag, &t.samples),
+                band.rect(k).width(),
+            )
+        });
         let steps = self.shift(band, steps.collect());
-        for (k, (lag, step)) in lags.iter_mut().zip(steps).enumerate() {
+        for (k, (tracked, step)) in lags.iter_mut().zip(steps).enumerate() {
             match step {
                 Step::Untouched => continue,
                 Step::Fresh => {
                     band.block(k).fill();
-                    *lag = Lag::default();
+                    tracked.lag = Lag::default();
                 }
                 Step::Swap { .. } => {}
             }
-            lag.look(band, &samples[k]);
+            tracked.lag.look(band, &tracked.samples);
         }
     }
 
