@@ -32,6 +32,10 @@ const SAMPLES: usize = NODES + CHECKS;
 /// Room for the samples in whole SIMD lanes.
 pub(super) const PADDED: usize = SAMPLES.div_ceil(8) * 8;
 
+/// A change at each sample, `[Δ Σ w·Δx, Δ Σ w·Δy, Δ Σ w]`, component by
+/// component (as the kernel writes it).
+pub(super) type Change = [[f32; PADDED]; 3];
+
 /// Share of the adaptive evaluation's check-point allowance that what the
 /// redos since a block was made have left out of its pixels may take, on
 /// top of the far field's own error checked then.
@@ -238,47 +242,52 @@ impl Lag {
     /// grow past its share (`allowed` per axis, canonical units) when they
     /// take nothing, or always when `now`. `None`, the lag left as it was,
     /// when even taking it would leave too much owed at the check points.
+    ///
+    /// Checked before written, so the lag is not copied to be kept: most
+    /// far blocks take nothing, at every redo.
     pub fn add(
         &mut self,
         samples: &Samples,
-        change: &[[f32; 3]],
+        change: &Change,
         allowed: [f32; 2],
         now: bool,
     ) -> Option<Take> {
-        let mut due = self.due;
-        let (nodes, checks) = change[..samples.len].split_at(samples.nodes);
-        for (p, c) in due.pending.iter_mut().zip(nodes) {
-            for m in 0..3 {
-                p[m] += c[m];
+        let nodes = samples.nodes;
+        let checks = samples.len - nodes;
+        let plus = |lag: [f32; 3], n: usize| std::array::from_fn(|m| lag[m] + change[m][n]);
+        let pending = |n: usize| plus(self.due.pending[n], n);
+        let owed = |k: usize| plus(self.due.owed[k], nodes + k);
+        if !now
+            && (0..nodes).all(|n| self.within(samples, n, pending(n), allowed))
+            && (0..checks).all(|k| self.within(samples, nodes + k, owed(k), allowed))
+        {
+            let due = &mut self.due;
+            for n in 0..nodes {
+                due.pending[n] = plus(due.pending[n], n);
             }
-        }
-        due.waiting = true;
-        for (owed, c) in due.owed.iter_mut().zip(checks) {
-            for m in 0..3 {
-                owed[m] += c[m];
+            for k in 0..checks {
+                due.owed[k] = plus(due.owed[k], nodes + k);
             }
-        }
-        if !now && self.within(&due, samples, allowed, true) {
-            self.due = due;
+            due.waiting = true;
             return Some(Take::Nothing);
         }
         let grid = Grid {
             nx: samples.nx,
             spacing: SPACING,
-            sums: due.pending[..samples.nodes].to_vec(),
+            sums: (0..nodes).map(pending).collect(),
         };
-        for (owed, (cell, at)) in due.owed.iter_mut().zip(samples.checks()) {
-            let taken = grid.at(cell, at);
-            for m in 0..3 {
-                owed[m] -= taken[m];
-            }
+        // What the check points still owe once the pixels take the grid.
+        let mut left = [[0f32; 3]; CHECKS];
+        for (k, (left, (cell, at))) in left.iter_mut().zip(samples.checks()).enumerate() {
+            let (owed, taken) = (owed(k), grid.at(cell, at));
+            *left = std::array::from_fn(|m| owed[m] - taken[m]);
         }
-        due.pending = [[0.0; 3]; NODES];
-        due.waiting = false;
-        if !self.within(&due, samples, allowed, false) {
+        if !(0..checks).all(|k| self.within(samples, nodes + k, left[k], allowed)) {
             return None;
         }
-        self.due = due;
+        self.due.pending = [[0.0; 3]; NODES];
+        self.due.owed[..checks].copy_from_slice(&left[..checks]);
+        self.due.waiting = false;
         Some(Take::Pending(grid))
     }
 
@@ -289,25 +298,19 @@ impl Lag {
         if !self.due.waiting {
             return Some(Take::Nothing);
         }
-        self.add(samples, &[[0.0; 3]; SAMPLES], allowed, true)
+        self.add(samples, &[[0.0; PADDED]; 3], allowed, true)
     }
 
-    /// Whether leaving out what `due` owes at the check points and, with
-    /// `at_nodes`, what is pending at the nodes, moves no sample's position
-    /// by more than `allowed`.
-    fn within(&self, due: &Due, samples: &Samples, allowed: [f32; 2], at_nodes: bool) -> bool {
-        let off = |n: usize, lag: [f32; 3]| {
-            let [px, py, w] = self.seen.0[n];
-            let w1 = w + lag[2];
-            let d = [px - samples.xs[n], py - samples.ys[n]];
-            (0..2).all(|axis| {
-                let off = (d[axis] * w + lag[axis]) / w1 - d[axis];
-                // NaNs compare false: they fail here too.
-                off.abs() <= allowed[axis]
-            })
-        };
-        let nodes_ok = !at_nodes || (0..samples.nodes).all(|n| off(n, due.pending[n]));
-        let checks = samples.len - samples.nodes;
-        nodes_ok && (0..checks).all(|k| off(samples.nodes + k, due.owed[k]))
+    /// Whether leaving `lag` out of sample `n`'s pixel moves its position
+    /// by no more than `allowed` per axis.
+    fn within(&self, samples: &Samples, n: usize, lag: [f32; 3], allowed: [f32; 2]) -> bool {
+        let [px, py, w] = self.seen.0[n];
+        let w1 = w + lag[2];
+        let d = [px - samples.xs[n], py - samples.ys[n]];
+        (0..2).all(|axis| {
+            let off = (d[axis] * w + lag[axis]) / w1 - d[axis];
+            // NaNs compare false: they fail here too.
+            off.abs() <= allowed[axis]
+        })
     }
 }

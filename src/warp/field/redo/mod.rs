@@ -327,13 +327,11 @@ impl Moved {
 
     /// The moved lines' change `[Δ Σ w·Δx, Δ Σ w·Δy, Δ Σ w]` at each
     /// sample.
-    fn changes_at(&self, samples: &Samples) -> Vec<[f32; 3]> {
+    fn changes_at(&self, samples: &Samples) -> lag::Change {
         let mut change = [[0f32; lag::PADDED]; 3];
         let (xs, ys) = (&samples.xs[..samples.len], &samples.ys[..samples.len]);
         (self.old).change_to(&self.new, xs, ys, change.each_mut().map(|v| &mut v[..]));
-        (0..samples.len)
-            .map(|k| std::array::from_fn(|m| change[m][k]))
-            .collect()
+        change
     }
 
     /// Swaps the moved lines' old terms for their new ones in every pixel
