@@ -109,10 +109,10 @@ impl Lines {
             // Far from every line a steep falloff can underflow all weights: hold still there.
             let ok = s.w.simd_gt(f32x8::ZERO);
             let inv = ok.select(f32x8::ONE / s.w, f32x8::ZERO);
-            out_x[k..k + take].copy_from_slice(&(x + s.x * inv).to_array()[..take]);
-            out_y[k..k + take].copy_from_slice(&(y + s.y * inv).to_array()[..take]);
+            store(&mut out_x[k..k + take], x + s.x * inv);
+            store(&mut out_y[k..k + take], y + s.y * inv);
             if let Some(w) = out_w.as_deref_mut() {
-                w[k..k + take].copy_from_slice(&s.w.to_array()[..take]);
+                store(&mut w[k..k + take], s.w);
             }
         });
     }
@@ -163,10 +163,7 @@ impl Lines {
         let mut k = 0;
         while k < xs.len() {
             let take = (xs.len() - k).min(8);
-            let (mut bx, mut by) = ([0f32; 8], [0f32; 8]);
-            bx[..take].copy_from_slice(&xs[k..k + take]);
-            by[..take].copy_from_slice(&ys[k..k + take]);
-            let (x, y) = (f32x8::new(bx), f32x8::new(by));
+            let (x, y) = (lanes(xs, k), lanes(ys, k));
             let old = self.sums8(&pow, x, y, Sums::default());
             let less = Sums {
                 x: -old.x,
@@ -215,11 +212,7 @@ impl Lines {
         let mut k = 0;
         while k < n {
             let take = (n - k).min(8);
-            let mut bx = [0f32; 8];
-            let mut by = [0f32; 8];
-            bx[..take].copy_from_slice(&xs[k..k + take]);
-            by[..take].copy_from_slice(&ys[k..k + take]);
-            let (x, y) = (f32x8::new(bx), f32x8::new(by));
+            let (x, y) = (lanes(xs, k), lanes(ys, k));
             let sums = self.sums8(&pow, x, y, base(k));
             sink(k, take, x, y, sums);
             k += take;
@@ -260,6 +253,32 @@ impl Lines {
             y: sy,
             w: ws,
         }
+    }
+}
+
+/// Eight values of `s` from `k` on, lanes past its end zero. Whole lanes
+/// are loaded as they are: copying a slice of a length the compiler cannot
+/// see calls `memcpy`, which at two calls per eight points cost as much as
+/// a line's arithmetic.
+#[inline(always)]
+fn lanes(s: &[f32], k: usize) -> f32x8 {
+    match s.get(k..k + 8) {
+        Some(whole) => f32x8::new(whole.try_into().expect("8 lanes")),
+        None => {
+            let mut b = [0f32; 8];
+            b[..s.len() - k].copy_from_slice(&s[k..]);
+            f32x8::new(b)
+        }
+    }
+}
+
+/// The first `out.len()` (at most 8) lanes of `v` into `out`.
+#[inline(always)]
+fn store(out: &mut [f32], v: f32x8) {
+    let v = v.to_array();
+    match <&mut [f32; 8]>::try_from(&mut *out) {
+        Ok(whole) => *whole = v,
+        Err(_) => out.copy_from_slice(&v[..out.len()]),
     }
 }
 
