@@ -1,5 +1,6 @@
-//! The field warp's hot loop: eight points per step across SIMD lanes, lines
-//! laid out as structure-of-arrays so every line constant is one broadcast.
+//! The field warp's hot loop: eight points per step across SIMD lanes, each
+//! line's constants together in one cache line, so every constant is one
+//! broadcast from a single base pointer.
 //! f32 keeps 8 lanes; positions up to 8K stay within ~0.001 px of the f64
 //! reference (tested in `tests.rs`).
 
