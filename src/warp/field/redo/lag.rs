@@ -192,8 +192,8 @@ impl Samples {
 
     /// Each sample in order: where it lies on the half-spacing lattice
     /// (across, up), and for a check point its place in a grid cell. In
-    /// order, not sample by sample: finding a sample's place on its own
-    /// takes divisions, which made up a tenth of a redo.
+    /// order, not sample by sample: finding one sample's place on its own
+    /// takes two divisions, at every sample of every block of a redo.
     fn points(&self) -> impl Iterator<Item = ((usize, usize), Option<Place>)> {
         let (nx, ny) = (self.nx, self.ny);
         let nodes = (0..ny).flat_map(move |c| (0..nx).map(move |a| ((2 * a, 2 * c), None)));
