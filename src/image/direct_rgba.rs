@@ -13,9 +13,13 @@
 //! iteration ([`blend_row`]): four independent loads close together keep
 //! more of them in flight, and no second row is written and read back.
 //!
-//! What bounds this kernel is memory latency more than arithmetic: a warp
-//! walks each output row across many source rows, so the taps of pixels a
-//! little ahead are asked of the cache early ([`Taps::prefetch`]).
+//! A warp walks each output row across many source rows, so the taps of
+//! pixels a little ahead are asked of the cache early ([`Taps::prefetch`]);
+//! each group of four is placed once, then ([`Ahead`]), and waits in a
+//! small ring for its turn. Past that the kernel is bound by how many
+//! instructions a pixel takes more than by memory: placing each group
+//! twice (once to prefetch, once to sample) cost a quarter of its time
+//! (docs/PERFORMANCE.md).
 //!
 //! Bilinear values are bit for bit those of the general path for other
 //! sample types and of the separate blend (the same fused multiply-adds in
@@ -88,14 +92,23 @@ pub(crate) struct Taps<'a, T> {
     cubic: bool,
 }
 
-/// Four positions (one eight-wide vector of x, y pairs) located in a source.
-struct Located {
+/// Where four positions (one eight-wide vector of x, y pairs) fall in a
+/// source: all a bilinear pixel needs.
+#[derive(Clone, Copy, Default)]
+struct Place {
     /// Two bits per pixel (x, y): set where that axis takes the fast path.
     fast: u32,
-    /// Offsets from `base` of each pixel's column and row, interleaved.
-    offsets: [i32; 8],
+    /// Index in the buffer of each pixel's first tap: its lower left one,
+    /// one column and one row further out for bicubic. Nonsense, and not
+    /// read, for a pixel off the fast path.
+    at: [i32; 4],
     /// Fractions (weights of the right and upper taps), interleaved.
     t: [f32; 8],
+}
+
+/// Four positions located for either filter.
+struct Located {
+    place: Place,
     /// Bicubic only: the Catmull-Rom weights of taps −1, 0, 1, 2 for each
     /// fraction, computed for all eight at once.
     w: [[f32; 8]; 4],
@@ -136,6 +149,26 @@ impl<'a, T: Sample> Taps<'a, T> {
 
     #[inline(always)]
     fn locate(&self, positions: &[f32; 8]) -> Located {
+        self.located(self.place(positions))
+    }
+
+    /// A placed four with the bicubic weights its fractions give.
+    #[inline(always)]
+    fn located(&self, place: Place) -> Located {
+        Located {
+            place,
+            w: match self.cubic {
+                true => {
+                    super::kernel::catmull_rom_weights8(f32x8::new(place.t)).map(f32x8::to_array)
+                }
+                false => [[0.0; 8]; 4],
+            },
+        }
+    }
+
+    /// Where four positions' taps lie, and which pixels take the fast path.
+    #[inline(always)]
+    fn place(&self, positions: &[f32; 8]) -> Place {
         let s = f32x8::splat;
         let (f, whole) = self.index(positions);
         let t = f - whole;
@@ -143,16 +176,19 @@ impl<'a, T: Sample> Taps<'a, T> {
         // fractions near a centre line, which the fallback snaps.
         let fast =
             f.simd_ge(self.lo) & f.simd_lt(self.hi) & t.simd_gt(s(SNAP)) & t.simd_lt(s(1.0 - SNAP));
-        Located {
+        // Relative to the corner: the first tap, one below the integer
+        // part for bicubic (whose `lo` is one above the corner).
+        let offsets = self.offsets(whole);
+        Place {
             fast: fast.to_bitmask(),
-            // Relative to the corner: the first tap, one below the integer
-            // part for bicubic (whose `lo` is one above the corner).
-            offsets: self.offsets(whole),
+            // Wrapping: a pixel off the fast path (NaN, far outside) may
+            // have any offsets, and its index is never used.
+            at: std::array::from_fn(|k| {
+                self.base
+                    .wrapping_add(offsets[2 * k])
+                    .wrapping_add(offsets[2 * k + 1])
+            }),
             t: t.to_array(),
-            w: match self.cubic {
-                true => super::kernel::catmull_rom_weights8(t).map(f32x8::to_array),
-                false => [[0.0; 8]; 4],
-            },
         }
     }
 
@@ -170,8 +206,8 @@ impl<'a, T: Sample> Taps<'a, T> {
         ((whole - self.lo).fast_trunc_int() * self.step).to_array()
     }
 
-    /// Asks the cache for the top row of taps of pixels 0 and 2 of four
-    /// positions, [`AHEAD`] groups before their turn.
+    /// Asks the cache for the top row of taps of pixels 0 and 2 of a
+    /// placed four, some time before their turn ([`Ahead`]).
     ///
     /// Rows go up the output, so the top row is the one no earlier output
     /// row brought in. A warp's taps wander across source rows along an
@@ -179,16 +215,12 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// hardware's stream prefetchers never lock onto: without this, each
     /// new cache line is a full memory latency with few others in flight.
     #[inline(always)]
-    fn prefetch(&self, positions: &[f32; 8]) {
-        let offsets = self.offsets(self.index(positions).1);
+    fn prefetch(&self, place: &Place) {
         let top = if self.cubic { 3 } else { 1 } * self.stride;
         for k in [0, 2] {
-            // Wrapping: NaN positions give nonsense indices, which `get`
-            // turns away (or which point at a harmless line).
-            let at = (self.base.wrapping_add(offsets[2 * k]))
-                .wrapping_add(offsets[2 * k + 1])
-                .wrapping_add(top);
-            if let Some(v) = self.data.get(at as u32 as usize) {
+            // Wrapping: a pixel off the fast path has a nonsense index,
+            // which `get` turns away (or which points at a harmless line).
+            if let Some(v) = self.data.get(place.at[k].wrapping_add(top) as u32 as usize) {
                 prefetch(v);
             }
         }
@@ -231,17 +263,14 @@ impl<'a, T: Sample> Taps<'a, T> {
         if self.cubic {
             return self.cubic_pixel(l, k);
         }
-        let (x, y) = (2 * k, 2 * k + 1);
-        // Indices inside the buffer, which fits `i32`; through `u32` the
-        // slice end cannot overflow, so one check per load remains.
-        let at = self.base + l.offsets[x] + l.offsets[y];
-        let (below, above) = self.rows_at(at);
+        let l = &l.place;
+        let (below, above) = self.rows_at(l.at[k]);
         // Each row's pair of horizontal neighbours blended vertically, then
         // the two halves horizontally.
         let v = (above - below)
-            .mul_add(f32x8::splat(l.t[y]), below)
+            .mul_add(f32x8::splat(l.t[2 * k + 1]), below)
             .to_array();
-        let tx = l.t[x];
+        let tx = l.t[2 * k];
         std::array::from_fn(|c| (v[4 + c] - v[c]).mul_add(tx, v[c]))
     }
 
@@ -249,10 +278,9 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// the fast path: the same operations as two [`Self::pixel`]s, the
     /// horizontal step for both pixels in one eight-wide vector.
     #[inline(always)]
-    fn pixel_pair(&self, l: &Located, k: usize) -> f32x8 {
+    fn pixel_pair(&self, l: &Place, k: usize) -> f32x8 {
         let vertical = |k: usize| {
-            let at = self.base + l.offsets[2 * k] + l.offsets[2 * k + 1];
-            let (below, above) = self.rows_at(at);
+            let (below, above) = self.rows_at(l.at[k]);
             (above - below)
                 .mul_add(f32x8::splat(l.t[2 * k + 1]), below)
                 .to_array()
@@ -276,7 +304,7 @@ impl<T: Sample> Taps<'_, T> {
     #[inline(always)]
     fn cubic_pixel(&self, l: &Located, k: usize) -> [f32; 4] {
         let (x, y) = (2 * k, 2 * k + 1);
-        let at = self.base + l.offsets[x] + l.offsets[y];
+        let at = l.place.at[k];
         let load = |at: i32| self.load(at);
         let w = &l.w;
         let pair = |a: f32, b: f32| f32x8::new([a, a, a, a, b, b, b, b]);
@@ -292,6 +320,43 @@ impl<T: Sample> Taps<'_, T> {
         let sum = far.mul_add(right, near * left);
         let v = sum.to_array();
         std::array::from_fn(|c| v[c] + v[4 + c])
+    }
+}
+
+/// A row's groups of four positions placed [`AHEAD`] groups before their
+/// turn, when their taps' top rows are asked of the cache
+/// ([`Taps::prefetch`]): placing each group once serves both.
+struct Ahead<'s, 'a, T> {
+    taps: &'s Taps<'a, T>,
+    groups: &'s [[f32; 8]],
+    /// Group `g`'s place in slot `g % AHEAD` until its turn.
+    ring: [Place; AHEAD],
+}
+
+impl<'s, 'a, T: Sample> Ahead<'s, 'a, T> {
+    fn new(taps: &'s Taps<'a, T>, groups: &'s [[f32; 8]]) -> Self {
+        let mut ring = [Place::default(); AHEAD];
+        for (slot, p) in ring.iter_mut().zip(groups) {
+            *slot = taps.place(p);
+            taps.prefetch(slot);
+        }
+        Ahead { taps, groups, ring }
+    }
+
+    /// Group `g`'s place, until [`Self::pass`] of `g`.
+    #[inline(always)]
+    fn place(&self, g: usize) -> &Place {
+        &self.ring[g % AHEAD]
+    }
+
+    /// Done with group `g`: group `g + AHEAD` is placed in its slot.
+    #[inline(always)]
+    fn pass(&mut self, g: usize) {
+        if let Some(p) = self.groups.get(g + AHEAD) {
+            let slot = &mut self.ring[g % AHEAD];
+            *slot = self.taps.place(p);
+            self.taps.prefetch(slot);
+        }
     }
 }
 
@@ -320,7 +385,7 @@ pub(crate) fn row<T: Sample>(
     // Pixels `first..` of a located group, one by one.
     let each = |l: &Located, first: usize, outs: &mut [[f32; 4]]| {
         for (k, o) in outs.iter_mut().enumerate() {
-            if (l.fast >> (2 * k)) & 3 == 3 {
+            if (l.place.fast >> (2 * k)) & 3 == 3 {
                 *o = taps.pixel(l, k);
             } else {
                 slow(first + k, o);
@@ -328,18 +393,17 @@ pub(crate) fn row<T: Sample>(
         }
     };
     let four = groups(positions);
-    for (g, (p, outs)) in four.iter().zip(out.chunks_exact_mut(4)).enumerate() {
-        if let Some(ahead) = four.get(g + AHEAD) {
-            taps.prefetch(ahead);
-        }
-        let l = taps.locate(p);
-        if PAIRS && l.fast == ALL_FAST && !taps.cubic {
+    let mut ahead = Ahead::new(taps, four);
+    for (g, outs) in out.chunks_exact_mut(4).enumerate() {
+        let place = ahead.place(g);
+        if PAIRS && place.fast == ALL_FAST && !taps.cubic {
             for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
-                put_pair(o, taps.pixel_pair(&l, k));
+                put_pair(o, taps.pixel_pair(place, k));
             }
-            continue;
+        } else {
+            each(&taps.located(*place), 4 * g, outs);
         }
-        each(&l, 4 * g, outs);
+        ahead.pass(g);
     }
     let done = four.len() * 4;
     if done < out.len() {
@@ -379,7 +443,8 @@ pub(crate) fn blend_row<S: Sample>(
     // Pixels `first..` of a located group of each source, one by one.
     let each = |(la, lb): (&Located, &Located), first: usize, outs: &mut [[f32; 4]]| {
         for (k, o) in outs.iter_mut().enumerate() {
-            let (fast_a, fast_b) = ((la.fast >> (2 * k)) & 3 == 3, (lb.fast >> (2 * k)) & 3 == 3);
+            let fast = |l: &Located| (l.place.fast >> (2 * k)) & 3 == 3;
+            let (fast_a, fast_b) = (fast(la), fast(lb));
             *o = if fast_a && fast_b {
                 blend(a.pixel(la, k), b.pixel(lb, k))
             } else {
@@ -391,24 +456,20 @@ pub(crate) fn blend_row<S: Sample>(
         }
     };
     let (four_a, four_b) = (groups(pa), groups(pb));
-    let pixels = out.chunks_exact_mut(4);
-    for (g, ((qa, qb), outs)) in four_a.iter().zip(four_b).zip(pixels).enumerate() {
-        if let (Some(qa), Some(qb)) = (four_a.get(g + AHEAD), four_b.get(g + AHEAD)) {
-            a.prefetch(qa);
-            b.prefetch(qb);
-        }
-        let (la, lb) = (a.locate(qa), b.locate(qb));
+    let (mut ahead_a, mut ahead_b) = (Ahead::new(a, four_a), Ahead::new(b, four_b));
+    for (g, outs) in out.chunks_exact_mut(4).enumerate() {
+        let (la, lb) = (ahead_a.place(g), ahead_b.place(g));
         if PAIRS && la.fast & lb.fast == ALL_FAST && !a.cubic && !b.cubic {
             let (wa8, wb8) = (f32x8::splat(wa), f32x8::splat(wb));
             for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
-                let v = b
-                    .pixel_pair(&lb, k)
-                    .mul_add(wb8, a.pixel_pair(&la, k) * wa8);
+                let v = b.pixel_pair(lb, k).mul_add(wb8, a.pixel_pair(la, k) * wa8);
                 put_pair(o, v);
             }
-            continue;
+        } else {
+            each((&a.located(*la), &b.located(*lb)), 4 * g, outs);
         }
-        each((&la, &lb), 4 * g, outs);
+        ahead_a.pass(g);
+        ahead_b.pass(g);
     }
     let done = four_a.len() * 4;
     if done < out.len() {

@@ -202,9 +202,10 @@ fn a_row_split_anywhere_samples_the_same_bits() {
     let img = Image::from_fn(bounds, 4, |i, j, c| {
         ((i * 37 + j * 101 + c as i32 * 7) % 97) as f32 / 97.0
     });
-    // Inside the image, off the pixel centres: the direct path's ground.
-    let positions: Vec<[f32; 2]> = (0..23)
-        .map(|k| [5.3 + 1.37 * k as f32, 4.6 + 0.71 * k as f32])
+    // Inside the image, off the pixel centres: the direct path's ground;
+    // more than the groups the direct path places ahead of their turn.
+    let positions: Vec<[f32; 2]> = (0..45)
+        .map(|k| [5.3 + 0.67 * k as f32, 4.6 + 0.5 * k as f32])
         .collect();
     let n = positions.len();
     for filter in [Filter::Bilinear, Filter::Bicubic] {
