@@ -42,10 +42,10 @@ use crate::geom::{PixelScale, RectI};
 pub(crate) const SNAP: f32 = 1e-4;
 
 /// How many groups of four pixels ahead [`Taps::prefetch`] asks for taps:
-/// 32 pixels, a few hundred nanoseconds at this kernel's pace, about one
-/// memory latency. Measured against 4, 12 and 16 (no better) in
-/// docs/PERFORMANCE.md.
-const AHEAD: usize = 8;
+/// 64 pixels, a few hundred nanoseconds at this kernel's pace, about one
+/// memory latency. Measured against 8 and 32 in docs/PERFORMANCE.md (8
+/// was best while each group was located twice, and slower since).
+const AHEAD: usize = 16;
 
 /// `Located::fast` when all four pixels take the direct path on both axes.
 const ALL_FAST: u32 = 0xff;
@@ -69,8 +69,13 @@ fn prefetch<T>(v: &T) {
 #[derive(Clone, Copy)]
 pub(crate) struct Taps<'a, T> {
     data: &'a [T],
-    /// Index of the first sample of the bounds' corner pixel.
-    base: i32,
+    /// Index of the first sample of the bounds' corner pixel, for
+    /// bilinear on a buffer stored top row first that of the pixel a row
+    /// up: where [`Place::at`] counts from.
+    origin: i32,
+    /// From [`Place::at`] to the taps' top row, which [`Self::prefetch`]
+    /// asks for.
+    top: i32,
     /// Samples from one row to the next row up.
     stride: i32,
     /// `stride`'s size, and whether the row up lies lower in the buffer
@@ -78,7 +83,7 @@ pub(crate) struct Taps<'a, T> {
     span: u32,
     flipped: bool,
     /// Samples per pixel and per row, interleaved: a pixel's offset from
-    /// `base` is the sum of a pair of its index (relative to the corner)
+    /// `origin` is the sum of a pair of its index (relative to the corner)
     /// times these. All `i32`: buffers this path takes are shorter than
     /// `i32::MAX`, and inside pixels' offsets lie within them.
     step: i32x8,
@@ -98,9 +103,10 @@ pub(crate) struct Taps<'a, T> {
 struct Place {
     /// Two bits per pixel (x, y): set where that axis takes the fast path.
     fast: u32,
-    /// Index in the buffer of each pixel's first tap: its lower left one,
-    /// one column and one row further out for bicubic. Nonsense, and not
-    /// read, for a pixel off the fast path.
+    /// Index in the buffer of each pixel's first tap: bilinear, the left
+    /// tap of whichever of its two rows lies lower in the buffer
+    /// ([`Taps::rows_at`]); bicubic, the lowest row's leftmost tap. Nonsense,
+    /// and not read, for a pixel off the fast path.
     at: [i32; 4],
     /// Fractions (weights of the right and upper taps), interleaved.
     t: [f32; 8],
@@ -133,9 +139,17 @@ impl<'a, T: Sample> Taps<'a, T> {
         let pairs = |x: f32, y: f32| f32x8::new([x, y, x, y, x, y, x, y]);
         // Taps reach `below` pixels under the integer part and `above` over it.
         let (below, above) = if cubic { (1, 2) } else { (0, 1) };
+        let base = layout.base as i32;
+        let (origin, top) = match (cubic, stride < 0) {
+            (true, _) => (base, stride.wrapping_mul(3)),
+            // The row up is the lower one: the place is the top row.
+            (false, true) => (base + stride, 0),
+            (false, false) => (base, stride),
+        };
         Some(Taps {
             data,
-            base: layout.base as i32,
+            origin,
+            top,
             stride,
             span: stride.unsigned_abs(),
             flipped: stride < 0,
@@ -184,7 +198,7 @@ impl<'a, T: Sample> Taps<'a, T> {
             // Wrapping: a pixel off the fast path (NaN, far outside) may
             // have any offsets, and its index is never used.
             at: std::array::from_fn(|k| {
-                self.base
+                self.origin
                     .wrapping_add(offsets[2 * k])
                     .wrapping_add(offsets[2 * k + 1])
             }),
@@ -200,7 +214,7 @@ impl<'a, T: Sample> Taps<'a, T> {
         (f, f.floor())
     }
 
-    /// Offsets from `base` of the first taps' columns and rows.
+    /// Offsets from `origin` of the first taps' columns and rows.
     #[inline(always)]
     fn offsets(&self, whole: f32x8) -> [i32; 8] {
         ((whole - self.lo).fast_trunc_int() * self.step).to_array()
@@ -216,27 +230,26 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// new cache line is a full memory latency with few others in flight.
     #[inline(always)]
     fn prefetch(&self, place: &Place) {
-        let top = if self.cubic { 3 } else { 1 } * self.stride;
         for k in [0, 2] {
             // Wrapping: a pixel off the fast path has a nonsense index,
             // which `get` turns away (or which points at a harmless line).
-            if let Some(v) = self.data.get(place.at[k].wrapping_add(top) as u32 as usize) {
+            if let Some(v) = self
+                .data
+                .get(place.at[k].wrapping_add(self.top) as u32 as usize)
+            {
                 prefetch(v);
             }
         }
     }
 
-    /// The eight samples from index `at` (two pixels of a tap row) and
-    /// the eight a row up, with one bounds check on the samples between
-    /// them instead of one per load: the offsets of both within it are
-    /// known to the compiler (each 0 or `span`, and `span` a `u32`).
+    /// The eight samples (two pixels of a tap row) from index `lower` and
+    /// the eight `span` after them, as the row below and the row above,
+    /// with one bounds check on the samples between them instead of one
+    /// per load: the offsets of both within it are known to the compiler
+    /// (each 0 or `span`, and `span` a `u32`).
     #[inline(always)]
-    fn rows_at(&self, at: i32) -> (f32x8, f32x8) {
+    fn rows_at(&self, lower: i32) -> (f32x8, f32x8) {
         let span = self.span as usize;
-        let lower = match self.flipped {
-            true => at.wrapping_add(self.stride),
-            false => at,
-        };
         // Indices inside the buffer, which fits `i32`; through `u32` the
         // slice end cannot overflow.
         let lower = lower as u32 as usize;
