@@ -5,7 +5,8 @@ clamped edges, as a host's plate would be resampled.
 
     python benches/remap_peer.py DIR
 
-Prints the median of each over 30 runs, in milliseconds: each into output
+Prints the median and the fastest of 30 runs of each, in milliseconds (on a
+shared machine the fastest is the steadier figure): each into output
 arrays made beforehand (`dst=`), as our kernels write into the buffer a
 host lends them (the peer figure), and into fresh arrays as a plain call
 makes them (which adds the kernel's page faults on 33 MB per array).
@@ -37,14 +38,21 @@ def plate(seed):
     return img
 
 
-def median_ms(f, runs=30):
-    f()
-    times = []
-    for _ in range(runs):
-        t = time.perf_counter()
+class Timed:
+    """Median and fastest of `runs` calls, in milliseconds."""
+
+    def __init__(self, f, runs=30):
         f()
-        times.append(time.perf_counter() - t)
-    return 1000 * sorted(times)[len(times) // 2]
+        times = []
+        for _ in range(runs):
+            t = time.perf_counter()
+            f()
+            times.append(time.perf_counter() - t)
+        times.sort()
+        self.median, self.fastest = 1000 * times[len(times) // 2], 1000 * times[0]
+
+    def __format__(self, spec):
+        return f"{self.median:.2f} ms (fastest {self.fastest:.2f})"
 
 
 def main(directory):
@@ -57,8 +65,8 @@ def main(directory):
     for name, interp in [("bilinear", cv2.INTER_LINEAR), ("bicubic", cv2.INTER_CUBIC)]:
         remap_a = lambda dst=None: cv2.remap(a, ax, ay, interp, dst=dst, borderMode=border)
         remap_b = lambda dst=None: cv2.remap(b, bx, by, interp, dst=dst, borderMode=border)
-        print(f"remap {name}: {median_ms(lambda: remap_a(wa)):.2f} ms"
-              f" (fresh arrays: {median_ms(remap_a):.2f} ms)")
+        print(f"remap {name}: {Timed(lambda: remap_a(wa))}"
+              f"; fresh arrays: {Timed(remap_a)}")
 
         def morph_into():
             remap_a(wa)
@@ -68,8 +76,8 @@ def main(directory):
         def morph_fresh():
             return cv2.addWeighted(remap_a(), 0.63, remap_b(), 0.37, 0.0)
 
-        print(f"2 x remap + addWeighted {name}: {median_ms(morph_into):.2f} ms"
-              f" (fresh arrays: {median_ms(morph_fresh):.2f} ms)")
+        print(f"2 x remap + addWeighted {name}: {Timed(morph_into)}"
+              f"; fresh arrays: {Timed(morph_fresh)}")
     print(f"threads: {cv2.getNumThreads()}")
 
 

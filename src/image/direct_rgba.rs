@@ -220,17 +220,20 @@ impl<'a, T: Sample> Taps<'a, T> {
         ((whole - self.lo).fast_trunc_int() * self.step).to_array()
     }
 
-    /// Asks the cache for the top row of taps of pixels 0 and 2 of a
-    /// placed four, some time before their turn ([`Ahead`]).
+    /// Asks the cache for the top row of taps of each pixel of a placed
+    /// four, some time before their turn ([`Ahead`]).
     ///
     /// Rows go up the output, so the top row is the one no earlier output
     /// row brought in. A warp's taps wander across source rows along an
     /// output row (a 100-line field warp's cross ~30 of them), which the
     /// hardware's stream prefetchers never lock onto: without this, each
     /// new cache line is a full memory latency with few others in flight.
+    /// Pixels 0 and 2 alone (whose lines the others' taps mostly share)
+    /// cost the dissolve, with two sources' taps in flight, a tenth of its
+    /// time.
     #[inline(always)]
     fn prefetch(&self, place: &Place) {
-        for k in [0, 2] {
+        for k in 0..4 {
             // Wrapping: a pixel off the fast path has a nonsense index,
             // which `get` turns away (or which points at a harmless line).
             if let Some(v) = self
