@@ -30,7 +30,8 @@
 //! four too (the last position repeated), so a row split anywhere (a
 //! host's tile) gives every pixel the same bits as the whole row.
 
-use wide::{f32x8, i32x8};
+use wide::bytemuck::cast;
+use wide::{f32x8, i32x8, u64x4};
 
 use super::{Layout, Sample};
 use crate::geom::{PixelScale, RectI};
@@ -46,6 +47,11 @@ pub(crate) const SNAP: f32 = 1e-4;
 /// memory latency. Measured against 8 and 32 in docs/PERFORMANCE.md (8
 /// was best while each group was located twice, and slower since).
 const AHEAD: usize = 16;
+
+const _: () = assert!(
+    cfg!(target_endian = "little"),
+    "Taps::first_taps reads 64-bit lanes' low halves as even lanes"
+);
 
 /// `Located::fast` when all four pixels take the direct path on both axes.
 const ALL_FAST: u32 = 0xff;
@@ -103,13 +109,22 @@ pub(crate) struct Taps<'a, T> {
 struct Place {
     /// Two bits per pixel (x, y): set where that axis takes the fast path.
     fast: u32,
-    /// Index in the buffer of each pixel's first tap: bilinear, the left
-    /// tap of whichever of its two rows lies lower in the buffer
-    /// ([`Taps::rows_at`]); bicubic, the lowest row's leftmost tap. Nonsense,
-    /// and not read, for a pixel off the fast path.
-    at: [i32; 4],
+    /// Index in the buffer of each pixel's first tap ([`Self::at`]), pixel
+    /// `k`'s in lane `2k` (where its x fraction lies); odd lanes unused.
+    first: [i32; 8],
     /// Fractions (weights of the right and upper taps), interleaved.
     t: [f32; 8],
+}
+
+impl Place {
+    /// Index in the buffer of pixel `k`'s first tap: bilinear, the left
+    /// tap of whichever of its two rows lies lower in the buffer
+    /// ([`Taps::rows_at`]); bicubic, the lowest row's leftmost tap.
+    /// Nonsense, and not read, for a pixel off the fast path.
+    #[inline(always)]
+    fn at(&self, k: usize) -> i32 {
+        self.first[2 * k]
+    }
 }
 
 /// Four positions located for either filter.
@@ -190,18 +205,9 @@ impl<'a, T: Sample> Taps<'a, T> {
         // fractions near a centre line, which the fallback snaps.
         let fast =
             f.simd_ge(self.lo) & f.simd_lt(self.hi) & t.simd_gt(s(SNAP)) & t.simd_lt(s(1.0 - SNAP));
-        // Relative to the corner: the first tap, one below the integer
-        // part for bicubic (whose `lo` is one above the corner).
-        let offsets = self.offsets(whole);
         Place {
             fast: fast.to_bitmask(),
-            // Wrapping: a pixel off the fast path (NaN, far outside) may
-            // have any offsets, and its index is never used.
-            at: std::array::from_fn(|k| {
-                self.origin
-                    .wrapping_add(offsets[2 * k])
-                    .wrapping_add(offsets[2 * k + 1])
-            }),
+            first: self.first_taps(whole).to_array(),
             t: t.to_array(),
         }
     }
@@ -214,10 +220,22 @@ impl<'a, T: Sample> Taps<'a, T> {
         (f, f.floor())
     }
 
-    /// Offsets from `origin` of the first taps' columns and rows.
+    /// Each pixel's first tap's index in the buffer in the even lane of
+    /// its pair: relative to the corner, the first tap, one below the
+    /// integer part for bicubic (whose `lo` is one above the corner).
+    ///
+    /// A pixel's column and row offsets, side by side, are the two halves
+    /// of one 64-bit lane, so one shift and one add sum all four pairs
+    /// (in the low halves), where taking the lanes apart cost nine
+    /// instructions. Wrapping, as the halves' low 32 bits: a pixel off
+    /// the fast path (NaN, far outside) may have any offsets, and its
+    /// index is never used. The low half is the even lane on a
+    /// little-endian target, which every target this builds for is.
     #[inline(always)]
-    fn offsets(&self, whole: f32x8) -> [i32; 8] {
-        ((whole - self.lo).fast_trunc_int() * self.step).to_array()
+    fn first_taps(&self, whole: f32x8) -> i32x8 {
+        let offsets = (whole - self.lo).fast_trunc_int() * self.step;
+        let pairs: u64x4 = cast(offsets);
+        cast::<u64x4, i32x8>(pairs + (pairs >> 32)) + i32x8::splat(self.origin)
     }
 
     /// Asks the cache for the top row of taps of each pixel of a placed
@@ -238,7 +256,7 @@ impl<'a, T: Sample> Taps<'a, T> {
             // which `get` turns away (or which points at a harmless line).
             if let Some(v) = self
                 .data
-                .get(place.at[k].wrapping_add(self.top) as u32 as usize)
+                .get(place.at(k).wrapping_add(self.top) as u32 as usize)
             {
                 prefetch(v);
             }
@@ -280,7 +298,7 @@ impl<'a, T: Sample> Taps<'a, T> {
             return self.cubic_pixel(l, k);
         }
         let l = &l.place;
-        let (below, above) = self.rows_at(l.at[k]);
+        let (below, above) = self.rows_at(l.at(k));
         // Each row's pair of horizontal neighbours blended vertically, then
         // the two halves horizontally.
         let v = (above - below)
@@ -296,7 +314,7 @@ impl<'a, T: Sample> Taps<'a, T> {
     #[inline(always)]
     fn pixel_pair(&self, l: &Place, k: usize) -> f32x8 {
         let vertical = |k: usize| {
-            let (below, above) = self.rows_at(l.at[k]);
+            let (below, above) = self.rows_at(l.at(k));
             (above - below)
                 .mul_add(f32x8::splat(l.t[2 * k + 1]), below)
                 .to_array()
@@ -320,7 +338,7 @@ impl<T: Sample> Taps<'_, T> {
     #[inline(always)]
     fn cubic_pixel(&self, l: &Located, k: usize) -> [f32; 4] {
         let (x, y) = (2 * k, 2 * k + 1);
-        let at = l.place.at[k];
+        let at = l.place.at(k);
         let load = |at: i32| self.load(at);
         let w = &l.w;
         let pair = |a: f32, b: f32| f32x8::new([a, a, a, a, b, b, b, b]);
