@@ -16,10 +16,12 @@
 //! A warp walks each output row across many source rows, so the taps of
 //! pixels a little ahead are asked of the cache early ([`Taps::prefetch`]);
 //! each group of four is placed once, then ([`Ahead`]), and waits in a
-//! small ring for its turn. Past that the kernel is bound by how many
-//! instructions a pixel takes more than by memory: placing each group
-//! twice (once to prefetch, once to sample) cost a quarter of its time
-//! (docs/PERFORMANCE.md).
+//! small ring for its turn: placing each group twice (once to prefetch,
+//! once to sample) cost a quarter of the time. Past that one source's
+//! resample is bound by the instructions a pixel takes, and the dissolve,
+//! with two sources' taps in flight on each core, by the memory the cores
+//! share (it scales 1.8× over two where the resample scales 2.3×;
+//! docs/PERFORMANCE.md).
 //!
 //! Bilinear values are bit for bit those of the general path for other
 //! sample types and of the separate blend (the same fused multiply-adds in
@@ -53,7 +55,7 @@ const _: () = assert!(
     "Taps::first_taps reads 64-bit lanes' low halves as even lanes"
 );
 
-/// `Located::fast` when all four pixels take the direct path on both axes.
+/// `Place::fast` when all four pixels take the direct path on both axes.
 const ALL_FAST: u32 = 0xff;
 
 /// Whether bilinear pixels go two at a time ([`Taps::pixel_pair`]): only
