@@ -8,6 +8,8 @@
 //! that redos may use. A one-pixel nudge of one line among many then
 //! touches the pixels near it and nothing else.
 
+use std::ops::Range;
+
 use super::super::grid::{self, Grid};
 use super::super::split::{Band, BLOCK};
 use crate::geom::{PixelScale, RectI};
@@ -32,9 +34,13 @@ const SAMPLES: usize = NODES + CHECKS;
 /// Room for the samples in whole SIMD lanes.
 pub(super) const PADDED: usize = SAMPLES.div_ceil(8) * 8;
 
-/// A change at each sample, `[Δ Σ w·Δx, Δ Σ w·Δy, Δ Σ w]`, component by
-/// component (as the kernel writes it).
-pub(super) type Change = [[f32; PADDED]; 3];
+/// A value per sample, component by component and padded to whole lanes,
+/// so the loops over a block's samples vectorise.
+pub(super) type PerSample = [[f32; PADDED]; 3];
+
+/// A change at each sample, `[Δ Σ w·Δx, Δ Σ w·Δy, Δ Σ w]` (as the kernel
+/// writes it).
+pub(super) type Change = PerSample;
 
 /// Share of the adaptive evaluation's check-point allowance that what the
 /// redos since a block was made have left out of its pixels may take, on
@@ -50,46 +56,32 @@ pub(super) struct Tracked {
     pub samples: Samples,
 }
 
-/// One block's lag.
-#[derive(Debug, Clone, Default)]
-pub(super) struct Lag {
-    due: Due,
-    /// What the block's pixels hold at each sample (position, `Σ w`), as
-    /// they were last written: read while they are in cache, not from a
-    /// map far larger than it at every redo.
-    seen: Seen,
-}
-
-/// What a block's pixels have not taken.
-#[derive(Debug, Clone, Copy)]
-struct Due {
-    /// At each grid node: the moved lines' changes `[Δ Σ w·Δx, Δ Σ w·Δy,
-    /// Δ Σ w]` summed over the redos since the pixels last took them.
-    pending: [[f32; 3]; NODES],
-    /// Whether `pending` holds anything.
-    waiting: bool,
-    /// At each check point: the exact changes since the block was made
-    /// less what its pixels took (interpolation is linear, so this is the
-    /// error of everything interpolated or left out since then).
-    owed: [[f32; 3]; CHECKS],
-}
-
-impl Default for Due {
-    fn default() -> Self {
-        Due {
-            pending: [[0.0; 3]; NODES],
-            waiting: false,
-            owed: [[0.0; 3]; CHECKS],
-        }
-    }
-}
-
+/// One block's lag: read and written at every redo for every block, so
+/// kept as small as the checks allow and laid out for SIMD.
 #[derive(Debug, Clone)]
-struct Seen([[f32; 3]; SAMPLES]);
+pub(super) struct Lag {
+    /// What the block's pixels have not taken, `[Δ Σ w·Δx, Δ Σ w·Δy,
+    /// Δ Σ w]`. At each grid node: the moved lines' changes summed over
+    /// the redos since the pixels last took them (what is pending). At
+    /// each check point: the exact changes since the block was made less
+    /// what its pixels took (interpolation is linear, so this is the error
+    /// of everything interpolated or left out since then: what is owed).
+    due: PerSample,
+    /// Whether the nodes hold anything pending.
+    waiting: bool,
+    /// What the block's pixels hold at each sample, as they were last
+    /// written: the position less the sample's own, and `Σ w`. Read while
+    /// they are in cache, not from a map far larger than it at every redo.
+    seen: PerSample,
+}
 
-impl Default for Seen {
+impl Default for Lag {
     fn default() -> Self {
-        Seen([[0.0; 3]; SAMPLES])
+        Lag {
+            due: [[0.0; PADDED]; 3],
+            waiting: false,
+            seen: [[0.0; PADDED]; 3],
+        }
     }
 }
 
@@ -98,7 +90,7 @@ impl Default for Seen {
 type Place = ((usize, usize), (f32, f32));
 
 /// Where a block's changes are sampled: its grid nodes then its check
-/// points, as canonical positions.
+/// points.
 ///
 /// Bilinear interpolation errs most at the centres of a cell's edges or at
 /// its centre: along an edge by `h²/8` times the second derivative along
@@ -106,11 +98,13 @@ type Place = ((usize, usize), (f32, f32));
 /// far line's is, the centre alone would see almost nothing). The check
 /// points are all three kinds: the cells' centres, then the centres of
 /// their edges across, then those up, each row by row.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct Samples {
-    /// Positions, padded to whole lanes.
-    pub xs: [f32; PADDED],
-    pub ys: [f32; PADDED],
+    /// Every sample lies on a half-spacing lattice: the canonical
+    /// coordinates of its columns and rows (kept instead of each sample's
+    /// position, which a redo rebuilds from them on the stack).
+    columns: [f32; 2 * NODES_ACROSS],
+    rows: [f32; 2 * NODES_ACROSS],
     /// Samples in all, and of them nodes.
     pub len: usize,
     nodes: usize,
@@ -130,28 +124,13 @@ const KINDS: [((i32, i32), (f32, f32)); 3] = [
     ((0, SPACING / 2), (0.0, 0.5)),
 ];
 
-impl Default for Samples {
-    fn default() -> Self {
-        Samples {
-            xs: [0.0; PADDED],
-            ys: [0.0; PADDED],
-            len: 0,
-            nodes: 0,
-            nx: 0,
-            ny: 0,
-            first: (0, 0),
-            last: (0, 0),
-        }
-    }
-}
-
 impl Samples {
     /// The samples of `block` at `scale`.
     pub fn of(block: RectI, scale: PixelScale) -> Self {
         let (nodes, nx) = grid::node_count(block, SPACING);
         let mut s = Samples {
-            xs: [0.0; PADDED],
-            ys: [0.0; PADDED],
+            columns: [0.0; 2 * NODES_ACROSS],
+            rows: [0.0; 2 * NODES_ACROSS],
             len: 0,
             nodes,
             nx,
@@ -159,23 +138,45 @@ impl Samples {
             first: (block.x1, block.y1),
             last: (block.x2 - 1, block.y2 - 1),
         };
-        // Every sample lies on a half-spacing lattice: its coordinates,
-        // once per column and row.
         let half = SPACING / 2;
-        let (mut columns, mut rows) = ([0f32; 2 * NODES_ACROSS], [0f32; 2 * NODES_ACROSS]);
-        for (k, c) in columns[..2 * nx].iter_mut().enumerate() {
+        for (k, c) in s.columns[..2 * nx].iter_mut().enumerate() {
             *c = scale.pixel_centre(block.x1 + k as i32 * half, 0).x as f32;
         }
-        for (k, r) in rows[..2 * s.ny].iter_mut().enumerate() {
+        for (k, r) in s.rows[..2 * s.ny].iter_mut().enumerate() {
             *r = scale.pixel_centre(0, block.y1 + k as i32 * half).y as f32;
         }
         let mut len = 0;
-        for ((a2, c2), _) in s.points() {
-            (s.xs[len], s.ys[len]) = (columns[a2], rows[c2]);
-            len += 1;
-        }
+        s.each(|n, _| len = n + 1);
         s.len = len;
         s
+    }
+
+    /// The samples' canonical positions, across and up, padded with zeros.
+    pub fn positions(&self) -> ([f32; PADDED], [f32; PADDED]) {
+        let (mut xs, mut ys) = ([0f32; PADDED], [0f32; PADDED]);
+        self.each(|n, (a2, c2)| (xs[n], ys[n]) = (self.columns[a2], self.rows[c2]));
+        (xs, ys)
+    }
+
+    /// Calls `f(n, (a2, c2))` for each sample `n` in order, with where it
+    /// lies on the half-spacing lattice (across, up): the order of
+    /// [`Samples::points`] in plain loops, which cost nothing per sample
+    /// where that iterator's chain costs a call (at every sample of every
+    /// block of a redo, twice).
+    #[inline(always)]
+    fn each(&self, mut f: impl FnMut(usize, (usize, usize))) {
+        let (nx, ny) = (self.nx, self.ny);
+        let mut n = 0;
+        let kinds = KINDS.map(|((di, dj), _)| (usize::from(di > 0), usize::from(dj > 0)));
+        for (da, dc) in [(0, 0)].into_iter().chain(kinds) {
+            // The nodes, then each kind of check point.
+            for c in 0..ny - dc {
+                for a in 0..nx - da {
+                    f(n, (2 * a + da, 2 * c + dc));
+                    n += 1;
+                }
+            }
+        }
     }
 
     /// The pixel a sample at `(a2, c2)` on the half-spacing lattice reads
@@ -230,11 +231,14 @@ impl Lag {
     /// Notes what the block's pixels in `band` hold at `samples`, after
     /// they were written.
     pub fn look(&mut self, band: &Band, samples: &Samples) {
-        for (seen, (at, _)) in self.seen.0[..samples.len].iter_mut().zip(samples.points()) {
+        let [dx, dy, ws] = &mut self.seen;
+        samples.each(|n, at| {
             let (i, j) = samples.pixel(at);
             let (p, w) = band.at(i, j);
-            *seen = [p[0], p[1], w];
-        }
+            dx[n] = p[0] - samples.columns[at.0];
+            dy[n] = p[1] - samples.rows[at.1];
+            ws[n] = w;
+        });
     }
 
     /// This redo's `change` at `samples` (the moved lines' change at each),
@@ -252,42 +256,40 @@ impl Lag {
         allowed: [f32; 2],
         now: bool,
     ) -> Option<Take> {
-        let nodes = samples.nodes;
-        let checks = samples.len - nodes;
-        let plus = |lag: [f32; 3], n: usize| std::array::from_fn(|m| lag[m] + change[m][n]);
-        let pending = |n: usize| plus(self.due.pending[n], n);
-        let owed = |k: usize| plus(self.due.owed[k], nodes + k);
-        if !now
-            && (0..nodes).all(|n| self.within(samples, n, pending(n), allowed))
-            && (0..checks).all(|k| self.within(samples, nodes + k, owed(k), allowed))
-        {
-            let due = &mut self.due;
-            for n in 0..nodes {
-                due.pending[n] = plus(due.pending[n], n);
+        let (nodes, len) = (samples.nodes, samples.len);
+        if !now && self.within(0..len, [&self.due, change], allowed) {
+            for (due, change) in self.due.iter_mut().zip(change) {
+                for (d, c) in due[..len].iter_mut().zip(&change[..len]) {
+                    *d += c;
+                }
             }
-            for k in 0..checks {
-                due.owed[k] = plus(due.owed[k], nodes + k);
-            }
-            due.waiting = true;
+            self.waiting = true;
             return Some(Take::Nothing);
         }
+        let mut left: PerSample =
+            std::array::from_fn(|m| std::array::from_fn(|n| self.due[m][n] + change[m][n]));
         let grid = Grid {
             nx: samples.nx,
             spacing: SPACING,
-            sums: (0..nodes).map(pending).collect(),
+            sums: (0..nodes)
+                .map(|n| std::array::from_fn(|m| left[m][n]))
+                .collect(),
         };
         // What the check points still owe once the pixels take the grid.
-        let mut left = [[0f32; 3]; CHECKS];
-        for (k, (left, (cell, at))) in left.iter_mut().zip(samples.checks()).enumerate() {
-            let (owed, taken) = (owed(k), grid.at(cell, at));
-            *left = std::array::from_fn(|m| owed[m] - taken[m]);
+        for (k, (cell, at)) in samples.checks().enumerate() {
+            let taken = grid.at(cell, at);
+            for (left, taken) in left.iter_mut().zip(taken) {
+                left[nodes + k] -= taken;
+            }
         }
-        if !(0..checks).all(|k| self.within(samples, nodes + k, left[k], allowed)) {
+        if !self.within(nodes..len, [&left, &NONE], allowed) {
             return None;
         }
-        self.due.pending = [[0.0; 3]; NODES];
-        self.due.owed[..checks].copy_from_slice(&left[..checks]);
-        self.due.waiting = false;
+        for (due, left) in self.due.iter_mut().zip(&left) {
+            due[..nodes].fill(0.0);
+            due[nodes..len].copy_from_slice(&left[nodes..len]);
+        }
+        self.waiting = false;
         Some(Take::Pending(grid))
     }
 
@@ -295,22 +297,68 @@ impl Lag {
     /// changes, if any, interpolated (`None` when that leaves too much
     /// owed, as in [`Lag::add`]).
     pub fn flush(&mut self, samples: &Samples, allowed: [f32; 2]) -> Option<Take> {
-        if !self.due.waiting {
+        if !self.waiting {
             return Some(Take::Nothing);
         }
-        self.add(samples, &[[0.0; PADDED]; 3], allowed, true)
+        self.add(samples, &NONE, allowed, true)
     }
 
-    /// Whether leaving `lag` out of sample `n`'s pixel moves its position
-    /// by no more than `allowed` per axis.
-    fn within(&self, samples: &Samples, n: usize, lag: [f32; 3], allowed: [f32; 2]) -> bool {
-        let [px, py, w] = self.seen.0[n];
-        let w1 = w + lag[2];
-        let d = [px - samples.xs[n], py - samples.ys[n]];
-        (0..2).all(|axis| {
-            let off = (d[axis] * w + lag[axis]) / w1 - d[axis];
+    /// Whether leaving the sum of `lag`'s two parts out of the pixels of
+    /// the samples in `range` moves none of their positions by more than
+    /// `allowed` per axis. One pass with no early exit, which vectorises.
+    fn within(&self, range: Range<usize>, lag: [&PerSample; 2], allowed: [f32; 2]) -> bool {
+        let n = range.len();
+        fn part(s: &PerSample, range: Range<usize>, n: usize) -> [&[f32]; 3] {
+            s.each_ref().map(|s| &s[range.clone()][..n])
+        }
+        let ([dx, dy, w], [ax, ay, aw], [bx, by, bw]) = (
+            part(&self.seen, range.clone(), n),
+            part(lag[0], range.clone(), n),
+            part(lag[1], range, n),
+        );
+        let mut ok = true;
+        for k in 0..n {
+            let w1 = w[k] + (aw[k] + bw[k]);
+            let off_x = (dx[k] * w[k] + (ax[k] + bx[k])) / w1 - dx[k];
+            let off_y = (dy[k] * w[k] + (ay[k] + by[k])) / w1 - dy[k];
             // NaNs compare false: they fail here too.
-            off.abs() <= allowed[axis]
-        })
+            ok &= (off_x.abs() <= allowed[0]) & (off_y.abs() <= allowed[1]);
+        }
+        ok
+    }
+}
+
+/// No change at any sample.
+const NONE: Change = [[0.0; PADDED]; 3];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plain loops a redo walks the samples by visit them in the order
+    /// of [`Samples::points`], which places the check points in their
+    /// cells: a whole block and blocks cut short by the window's edges.
+    #[test]
+    fn the_loops_over_samples_follow_the_points_order() {
+        let scale = PixelScale::new(0.5, 0.5, 1.0);
+        for block in [
+            RectI::new(0, 0, BLOCK, BLOCK),
+            RectI::new(96, 48, 96 + 13, 48 + BLOCK),
+            RectI::new(0, 0, 3, 1),
+        ] {
+            let samples = Samples::of(block, scale);
+            let mut walked = Vec::new();
+            samples.each(|n, at| walked.push((n, at)));
+            let listed: Vec<_> = samples.points().map(|(at, _)| at).enumerate().collect();
+            assert_eq!(walked, listed, "{block:?}");
+            assert_eq!(samples.len, listed.len());
+            let (xs, ys) = samples.positions();
+            for (n, (a2, c2)) in listed {
+                let half = SPACING / 2;
+                let (i, j) = (block.x1 + a2 as i32 * half, block.y1 + c2 as i32 * half);
+                let centre = scale.pixel_centre(i, j);
+                assert_eq!((xs[n], ys[n]), (centre.x as f32, centre.y as f32));
+            }
+        }
     }
 }

@@ -329,7 +329,8 @@ impl Moved {
     /// sample.
     fn changes_at(&self, samples: &Samples) -> lag::Change {
         let mut change = [[0f32; lag::PADDED]; 3];
-        let (xs, ys) = (&samples.xs[..samples.len], &samples.ys[..samples.len]);
+        let (xs, ys) = samples.positions();
+        let (xs, ys) = (&xs[..samples.len], &ys[..samples.len]);
         (self.old).change_to(&self.new, xs, ys, change.each_mut().map(|v| &mut v[..]));
         change
     }
