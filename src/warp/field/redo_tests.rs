@@ -273,3 +273,67 @@ fn the_65th_map_of_a_drag_is_made_in_full() {
         assert_eq!(kept.redos(), step % 65, "map {step}");
     }
 }
+
+/// A block made from a grid reports the largest error its check points
+/// found, per axis, against the exact map (a redo's lag takes only what
+/// that leaves of their allowance); a block made exactly reports none.
+#[test]
+fn a_made_block_reports_its_check_points_largest_error() {
+    let proxy = window_at(0.5);
+    let small = (RectI::new(0, 0, 160, 96), PixelScale::UNIT);
+    let (mut from_grid, mut exactly) = (0, 0);
+    for (n, (window, scale)) in [(40, proxy), (3, small)] {
+        let size = window.width() as f64 / scale.x;
+        let pairs = spread_pairs(14, n, size, window.height() as f64 / scale.y);
+        let (grid, exact) = check_reported_errors(pairs, window, scale);
+        (from_grid, exactly) = (from_grid + grid, exactly + exact);
+    }
+    assert!(
+        from_grid > 10 && exactly > 0,
+        "{from_grid} from a grid, {exactly} exactly"
+    );
+}
+
+/// Holds each block's reported error to the exact map's at its check
+/// points; how many blocks were made from a grid and how many exactly.
+fn check_reported_errors(pairs: Vec<LinePair>, window: RectI, scale: PixelScale) -> (usize, usize) {
+    use super::split::{check_points, Setup};
+    let warp = FieldWarp::new(pairs.clone(), &adaptive());
+    let truth = FieldWarp::new(pairs, &exact(0.001)).map_window(window, scale);
+    let setup = Setup::new(&warp, window, scale, Some(Evaluation::DEFAULT_TOLERANCE));
+    let mut pos = vec![[0f32; 2]; window.area()];
+    let mut made = vec![(RectI::default(), [0f32; 2]); setup.block_count()];
+    setup.each_band(&mut pos, None, &mut made, |band, made| {
+        for (k, made) in made.iter_mut().enumerate() {
+            *made = (band.rect(k), band.block(k).fill());
+        }
+    });
+    let map = WarpMap::new(window, scale, pos);
+    let (mut from_grid, mut exactly) = (0, 0);
+    for (block, reported) in made {
+        let mut worst = [0f32; 2];
+        for (i, j) in check_points(block) {
+            let (got, want) = (map.get(i, j), truth.get(i, j));
+            worst[0] = worst[0].max((got.x - want.x).abs() as f32);
+            worst[1] = worst[1].max((got.y - want.y).abs() as f32);
+        }
+        let exact_block = (block.y1..block.y2)
+            .all(|j| (block.x1..block.x2).all(|i| map.get(i, j) == truth.get(i, j)));
+        if exact_block {
+            assert_eq!(reported, [0.0; 2], "{block:?}");
+            exactly += 1;
+            continue;
+        }
+        for axis in 0..2 {
+            let slack = 1e-5 * (1.0 + worst[axis]);
+            assert!(
+                (reported[axis] - worst[axis]).abs() <= slack,
+                "{block:?} axis {axis}: reported {} against {}",
+                reported[axis],
+                worst[axis]
+            );
+        }
+        from_grid += 1;
+    }
+    (from_grid, exactly)
+}

@@ -243,11 +243,13 @@ struct Sets {
 
 impl Block<'_> {
     /// Evaluates the block: near lines exactly, far ones from a grid when
-    /// that passes the checks, else all exactly.
-    pub fn fill(&mut self) {
+    /// that passes the checks, else all exactly. Returns the largest error
+    /// its check points found per axis (canonical units; zero where every
+    /// pixel is exact).
+    pub fn fill(&mut self) -> [f32; 2] {
         if self.setup.tol.is_none() {
             self.exact();
-            return;
+            return [0.0; 2];
         }
         let (lo, hi) = corners(self.rect);
         let mut sets = std::mem::take(&mut self.scratch.sets);
@@ -263,7 +265,7 @@ impl Block<'_> {
         if sets.far_idx.is_empty() {
             self.scratch.sets = sets;
             self.exact();
-            return;
+            return [0.0; 2];
         }
         let all = &self.setup.warp.kernel;
         all.select_into(&sets.far_idx, &mut sets.far);
@@ -271,9 +273,10 @@ impl Block<'_> {
         let grid = self.far_grid(&sets.far);
         self.rows(&sets.near, Some(&grid));
         self.scratch.sets = sets;
-        if !self.checks_pass() {
+        self.checked().unwrap_or_else(|| {
             self.exact();
-        }
+            [0.0; 2]
+        })
     }
 
     /// Canonical position of the centre of pixel `(i, j)`.
@@ -362,9 +365,11 @@ impl Block<'_> {
 
     /// Compares the block with the exact map at the centres of every other
     /// grid cell (where bilinear interpolation errs most).
-    fn checks_pass(&mut self) -> bool {
+    /// The largest error per axis at the check points (canonical units),
+    /// or `None` when one misses the tolerance.
+    fn checked(&mut self) -> Option<[f32; 2]> {
         let Some(tol) = self.setup.tol else {
-            return true;
+            return Some([0.0; 2]);
         };
         let b = self.rect;
         let pixels: Vec<(i32, i32)> = check_points(b).collect();
@@ -374,10 +379,17 @@ impl Block<'_> {
             .warp
             .kernel
             .map_points(&xs, &ys, &mut ox, &mut oy);
-        pixels.iter().enumerate().all(|(k, &(i, j))| {
+        let mut worst = [0f32; 2];
+        for (k, &(i, j)) in pixels.iter().enumerate() {
             let got = self.row_mut(j)[(i - b.x1) as usize];
-            (got[0] - ox[k]).abs() <= tol[0] && (got[1] - oy[k]).abs() <= tol[1]
-        })
+            let err = [(got[0] - ox[k]).abs(), (got[1] - oy[k]).abs()];
+            // NaNs compare false: they fail here too.
+            if !(err[0] <= tol[0] && err[1] <= tol[1]) {
+                return None;
+            }
+            worst = [worst[0].max(err[0]), worst[1].max(err[1])];
+        }
+        Some(worst)
     }
 }
 
@@ -392,7 +404,7 @@ pub(super) fn corners(block: RectI) -> (Vec2, Vec2) {
 
 /// The centres of every other grid cell of `block`, where bilinear
 /// interpolation errs most.
-fn check_points(block: RectI) -> impl Iterator<Item = (i32, i32)> {
+pub(super) fn check_points(block: RectI) -> impl Iterator<Item = (i32, i32)> {
     let step = (2 * GRID) as usize;
     let ys = (block.y1 + GRID / 2..block.y2).step_by(step);
     ys.flat_map(move |j| {

@@ -197,7 +197,7 @@ impl FieldWarp {
         let mut lags = vec![Tracked::default(); setup.block_count()];
         setup.each_band(&mut pos, Some(&mut weights), &mut lags, |band, lags| {
             for (k, tracked) in lags.iter_mut().enumerate() {
-                band.block(k).fill();
+                tracked.made = band.block(k).fill();
                 tracked.samples = Samples::of(band.rect(k), band.setup.scale);
                 tracked.lag.look(band, &tracked.samples);
             }
@@ -275,18 +275,16 @@ impl Moved {
     /// sums cannot take the swap evaluated exactly, and a block with many
     /// of them evaluated afresh.
     fn redo(&self, band: &mut Band, lags: &mut [Tracked]) {
-        let steps = lags.iter_mut().enumerate().map(|(k, t)| {
-            Step::of(
-                self.plan(band, k, &mut t.lag, &t.samples),
-                band.rect(k).width(),
-            )
-        });
+        let steps = lags
+            .iter_mut()
+            .enumerate()
+            .map(|(k, t)| Step::of(self.plan(band, k, t), band.rect(k).width()));
         let steps = self.shift(band, steps.collect());
         for (k, (tracked, step)) in lags.iter_mut().zip(steps).enumerate() {
             match step {
                 Step::Untouched => continue,
                 Step::Fresh => {
-                    band.block(k).fill();
+                    tracked.made = band.block(k).fill();
                     tracked.lag = Lag::default();
                 }
                 Step::Swap { .. } => {}
@@ -304,11 +302,12 @@ impl Moved {
     /// picks the pixels to evaluate exactly. Far from them, as far as an adaptive
     /// evaluation's far lines, the change is known from the block's grid
     /// and waits in its [`Lag`] until it matters.
-    fn plan(&self, band: &Band, k: usize, lag: &mut Lag, samples: &Samples) -> Option<Plan> {
+    fn plan(&self, band: &Band, k: usize, tracked: &mut Tracked) -> Option<Plan> {
         let Some(tol) = band.setup.tolerance() else {
             return Some(Plan::Exact(None));
         };
-        let allowed = tol.map(|t| t * lag::SHARE);
+        let (lag, samples) = (&mut tracked.lag, &tracked.samples);
+        let allowed = std::array::from_fn(|a| (tol[a] - tracked.made[a]).max(0.0) * lag::SHARE);
         let (lo, hi) = corners(band.rect(k));
         let close = |&(p, q): &(Vec2, Vec2)| is_within(p, q, lo, hi, CLOSE);
         if !self.segments.iter().any(close) {
