@@ -161,6 +161,13 @@ pub(super) struct Band<'a> {
 }
 
 impl Band<'_> {
+    /// Where block `k` of the band comes among the window's blocks, row
+    /// by row.
+    pub fn index(&self, k: usize) -> usize {
+        let row = ((self.y1 - self.setup.window.y1) / BLOCK) as usize;
+        row * self.setup.blocks_across() + k
+    }
+
     /// The pixels of block `k` of the band, from the left.
     pub fn rect(&self, k: usize) -> RectI {
         let (x1, cols) = (self.setup.window.x1, self.setup.block_columns(k));

@@ -62,6 +62,8 @@ pub(super) struct Tracked {
     /// The largest error the block's check points found per axis when it
     /// was last evaluated afresh (canonical units).
     pub made: [f32; 2],
+    /// Redos that wrote its pixels since then.
+    pub swaps: u32,
 }
 
 /// One block's lag: read and written at every redo for every block, so
