@@ -35,6 +35,13 @@ fn worst_px(a: &WarpMap, b: &WarpMap) -> f64 {
     worst
 }
 
+/// Holds `map` within the adaptive tolerance of the exact map of `pairs`.
+fn assert_within_tolerance(map: &WarpMap, pairs: Vec<LinePair>) {
+    let truth = FieldWarp::new(pairs, &exact(0.001)).map_window(map.window, map.scale);
+    let err = worst_px(map, &truth);
+    assert!(err <= Evaluation::DEFAULT_TOLERANCE, "{err} px from exact");
+}
+
 fn window_at(scale: f64) -> (RectI, PixelScale) {
     let s = PixelScale::new(scale, scale, 1.0);
     (
@@ -236,9 +243,7 @@ fn a_nudge_leaves_pixels_far_from_the_line_untouched() {
         near_moved > 1000,
         "the pixels near the line moved: {near_moved}"
     );
-    let truth = FieldWarp::new(nudged, &exact(0.001)).map_window(window, scale);
-    let err = worst_px(after.map(), &truth);
-    assert!(err <= Evaluation::DEFAULT_TOLERANCE, "{err} px from exact");
+    assert_within_tolerance(after.map(), nudged);
 }
 
 /// Handing the map over edits it in place into the map a redo of a copy
@@ -292,9 +297,7 @@ fn a_long_drag_renews_its_blocks_in_turn_and_never_the_whole_map() {
         renewed_at_once.iter().all(|&n| n <= blocks.div_ceil(8)),
         "{blocks} blocks, renewed at once: {renewed_at_once:?}"
     );
-    let truth = FieldWarp::new(pairs, &exact(0.001)).map_window(window, scale);
-    let err = worst_px(kept.map(), &truth);
-    assert!(err <= Evaluation::DEFAULT_TOLERANCE, "{err} px from exact");
+    assert_within_tolerance(kept.map(), pairs);
 }
 
 /// A block made from a grid reports the largest error its check points
