@@ -94,7 +94,8 @@ impl FieldMap {
     }
 
     /// How many redos this map is from a full evaluation (0: it is one).
-    /// Its blocks were made afresh at most 64 redos ago each.
+    /// No block has been written by more than 64 redos since it was made
+    /// afresh.
     pub fn redos(&self) -> u32 {
         self.redos
     }
