@@ -126,13 +126,10 @@ pub(super) struct Samples {
     last: (i32, i32),
 }
 
-/// Per kind of check point: its offset from a node (pixels) and its place
-/// in the cell, and whether it needs a next node across and up.
-const KINDS: [((i32, i32), (f32, f32)); 3] = [
-    ((SPACING / 2, SPACING / 2), (0.5, 0.5)),
-    ((SPACING / 2, 0), (0.5, 0.0)),
-    ((0, SPACING / 2), (0.0, 0.5)),
-];
+/// Per kind of check point, whether it lies half a cell across and half
+/// a cell up from a node: cells' centres, then the centres of their edges
+/// across, then those up.
+const KINDS: [(usize, usize); 3] = [(1, 1), (1, 0), (0, 1)];
 
 impl Samples {
     /// The samples of `block` at `scale`.
@@ -169,17 +166,15 @@ impl Samples {
     }
 
     /// Calls `f(n, (a2, c2))` for each sample `n` in order, with where it
-    /// lies on the half-spacing lattice (across, up): the order of
-    /// [`Samples::points`] in plain loops, which cost nothing per sample
-    /// where that iterator's chain costs a call (at every sample of every
-    /// block of a redo, twice).
+    /// lies on the half-spacing lattice (across, up): the nodes row by
+    /// row (as a [`Grid`] holds them), then each kind of check point row
+    /// by row. Plain loops, which cost nothing per sample, where a chained
+    /// iterator cost a call (at every sample of every block of a redo).
     #[inline(always)]
     fn each(&self, mut f: impl FnMut(usize, (usize, usize))) {
         let (nx, ny) = (self.nx, self.ny);
         let mut n = 0;
-        let kinds = KINDS.map(|((di, dj), _)| (usize::from(di > 0), usize::from(dj > 0)));
-        for (da, dc) in [(0, 0)].into_iter().chain(kinds) {
-            // The nodes, then each kind of check point.
+        for (da, dc) in [(0, 0)].into_iter().chain(KINDS) {
             for c in 0..ny - dc {
                 for a in 0..nx - da {
                     f(n, (2 * a + da, 2 * c + dc));
@@ -187,6 +182,16 @@ impl Samples {
                 }
             }
         }
+    }
+
+    /// Where the check point at `(a2, c2)` on the half-spacing lattice
+    /// lies in the grid: one on the grid's last row or column lies on the
+    /// far edge of the cell before it.
+    fn place(&self, (a2, c2): (usize, usize)) -> Place {
+        let (a, c) = (a2 / 2, c2 / 2);
+        let cell = (a.min(self.nx - 2), c.min(self.ny - 2));
+        let half = |odd: usize, whole: usize| 0.5 * (odd % 2) as f32 + whole as f32;
+        (cell, (half(a2, a - cell.0), half(c2, c - cell.1)))
     }
 
     /// The pixel a sample at `(a2, c2)` on the half-spacing lattice reads
@@ -199,33 +204,6 @@ impl Samples {
             self.first.1 + c2 as i32 * half,
         );
         (i.min(self.last.0), j.min(self.last.1))
-    }
-
-    /// Each sample in order: where it lies on the half-spacing lattice
-    /// (across, up), and for a check point its place in a grid cell. In
-    /// order, not sample by sample: finding one sample's place on its own
-    /// takes two divisions, at every sample of every block of a redo.
-    fn points(&self) -> impl Iterator<Item = ((usize, usize), Option<Place>)> {
-        let (nx, ny) = (self.nx, self.ny);
-        let nodes = (0..ny).flat_map(move |c| (0..nx).map(move |a| ((2 * a, 2 * c), None)));
-        let checks = KINDS.into_iter().flat_map(move |((di, dj), at)| {
-            let (da, dc) = (usize::from(di > 0), usize::from(dj > 0));
-            (0..ny - dc).flat_map(move |c| {
-                (0..nx - da).map(move |a| {
-                    // A point on the grid's last row or column lies on the
-                    // far edge of the cell before it.
-                    let cell = (a.min(nx - 2), c.min(ny - 2));
-                    let at = (at.0 + (a - cell.0) as f32, at.1 + (c - cell.1) as f32);
-                    ((2 * a + da, 2 * c + dc), Some((cell, at)))
-                })
-            })
-        });
-        nodes.chain(checks)
-    }
-
-    /// The check points' places, in order.
-    fn checks(&self) -> impl Iterator<Item = Place> {
-        self.points().filter_map(|(_, place)| place)
     }
 }
 
@@ -286,12 +264,14 @@ impl Lag {
                 .collect(),
         };
         // What the check points still owe once the pixels take the grid.
-        for (k, (cell, at)) in samples.checks().enumerate() {
-            let taken = grid.at(cell, at);
-            for (left, taken) in left.iter_mut().zip(taken) {
-                left[nodes + k] -= taken;
+        samples.each(|n, at| {
+            if n >= nodes {
+                let (cell, at) = samples.place(at);
+                for (left, taken) in left.iter_mut().zip(grid.at(cell, at)) {
+                    left[n] -= taken;
+                }
             }
-        }
+        });
         if !self.within(nodes..len, [&left, &NONE], allowed) {
             return None;
         }
@@ -345,11 +325,12 @@ const NONE: Change = [[0.0; PADDED]; 3];
 mod tests {
     use super::*;
 
-    /// The plain loops a redo walks the samples by visit them in the order
-    /// of [`Samples::points`], which places the check points in their
-    /// cells: a whole block and blocks cut short by the window's edges.
+    /// The samples of a whole block and of blocks cut short by the
+    /// window's edges: the nodes first, row by row as a grid holds them,
+    /// then check points each placed in the cell whose centre or edge it
+    /// is, every sample once, at its pixel centre.
     #[test]
-    fn the_loops_over_samples_follow_the_points_order() {
+    fn samples_are_the_grid_nodes_then_check_points_placed_in_their_cells() {
         let scale = PixelScale::new(0.5, 0.5, 1.0);
         for block in [
             RectI::new(0, 0, BLOCK, BLOCK),
@@ -357,18 +338,33 @@ mod tests {
             RectI::new(0, 0, 3, 1),
         ] {
             let samples = Samples::of(block, scale);
+            let (nodes, nx) = grid::node_count(block, SPACING);
             let mut walked = Vec::new();
             samples.each(|n, at| walked.push((n, at)));
-            let listed: Vec<_> = samples.points().map(|(at, _)| at).enumerate().collect();
-            assert_eq!(walked, listed, "{block:?}");
-            assert_eq!(samples.len, listed.len());
+            assert_eq!(walked.len(), samples.len, "{block:?}");
             let (xs, ys) = samples.positions();
-            for (n, (a2, c2)) in listed {
-                let half = SPACING / 2;
+            let half = SPACING / 2;
+            for &(n, (a2, c2)) in &walked {
+                if n < nodes {
+                    assert_eq!((a2, c2), (2 * (n % nx), 2 * (n / nx)), "{block:?} node {n}");
+                } else {
+                    assert!(a2 % 2 == 1 || c2 % 2 == 1, "{block:?} check {n} on a node");
+                    let ((a, c), (fx, fy)) = samples.place((a2, c2));
+                    assert!(a + 1 < nx && c + 1 < nodes / nx, "{block:?} check {n}");
+                    assert!((0.0..=1.0).contains(&fx) && (0.0..=1.0).contains(&fy));
+                    assert_eq!(
+                        (2.0 * (a as f32 + fx), 2.0 * (c as f32 + fy)),
+                        (a2 as f32, c2 as f32)
+                    );
+                }
                 let (i, j) = (block.x1 + a2 as i32 * half, block.y1 + c2 as i32 * half);
                 let centre = scale.pixel_centre(i, j);
                 assert_eq!((xs[n], ys[n]), (centre.x as f32, centre.y as f32));
             }
+            let mut at: Vec<_> = walked.iter().map(|&(_, at)| at).collect();
+            at.sort_unstable();
+            at.dedup();
+            assert_eq!(at.len(), walked.len(), "{block:?}: a sample twice");
         }
     }
 }
