@@ -33,7 +33,7 @@
 //! host's tile) gives every pixel the same bits as the whole row.
 
 use wide::bytemuck::cast;
-use wide::{f32x8, i32x8, u64x4};
+use wide::{f32x8, i32x8, u32x8, u64x4};
 
 use super::{Layout, Sample};
 use crate::geom::{PixelScale, RectI};
@@ -253,13 +253,14 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// time.
     #[inline(always)]
     fn prefetch(&self, place: &Place) {
+        // Wrapping, then clamped into the buffer, all four at once: a
+        // pixel off the fast path has a nonsense index, and the line it
+        // then asks for is a harmless one.
+        let last = u32x8::splat((self.data.len() as u32).wrapping_sub(1));
+        let tops: u32x8 = cast(i32x8::new(place.first) + i32x8::splat(self.top));
+        let tops = tops.min(last).to_array();
         for k in 0..4 {
-            // Wrapping: a pixel off the fast path has a nonsense index,
-            // which `get` turns away (or which points at a harmless line).
-            if let Some(v) = self
-                .data
-                .get(place.at(k).wrapping_add(self.top) as u32 as usize)
-            {
+            if let Some(v) = self.data.get(tops[2 * k] as usize) {
                 prefetch(v);
             }
         }
@@ -269,18 +270,19 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// the eight `span` after them, as the row below and the row above,
     /// with one bounds check on the samples between them instead of one
     /// per load: the offsets of both within it are known to the compiler
-    /// (each 0 or `span`, and `span` a `u32`).
+    /// (each 0 or `span`, and `span` a `u32`). `FLIP` is
+    /// [`Self::flipped`], a constant in each row's loop ([`row`],
+    /// [`blend_row`]): chosen per pixel, it cost a dozen instructions
+    /// and the checks the offsets spare.
     #[inline(always)]
-    fn rows_at(&self, lower: i32) -> (f32x8, f32x8) {
+    fn rows_at<const FLIP: bool>(&self, lower: i32) -> (f32x8, f32x8) {
+        debug_assert_eq!(FLIP, self.flipped);
         let span = self.span as usize;
         // Indices inside the buffer, which fits `i32`; through `u32` the
         // slice end cannot overflow.
         let lower = lower as u32 as usize;
         let both = &self.data[lower..lower + span + 8];
-        let (below, above) = match self.flipped {
-            true => (span, 0),
-            false => (0, span),
-        };
+        let (below, above) = if FLIP { (span, 0) } else { (0, span) };
         (T::load8(&both[below..]), T::load8(&both[above..]))
     }
 
@@ -295,12 +297,12 @@ impl<'a, T: Sample> Taps<'a, T> {
 
     /// Pixel `k` of a located four, both axes on the fast path.
     #[inline(always)]
-    fn pixel(&self, l: &Located, k: usize) -> [f32; 4] {
+    fn pixel<const FLIP: bool>(&self, l: &Located, k: usize) -> [f32; 4] {
         if self.cubic {
             return self.cubic_pixel(l, k);
         }
         let l = &l.place;
-        let (below, above) = self.rows_at(l.at(k));
+        let (below, above) = self.rows_at::<FLIP>(l.at(k));
         // Each row's pair of horizontal neighbours blended vertically, then
         // the two halves horizontally.
         let v = (above - below)
@@ -314,9 +316,9 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// the fast path: the same operations as two [`Self::pixel`]s, the
     /// horizontal step for both pixels in one eight-wide vector.
     #[inline(always)]
-    fn pixel_pair(&self, l: &Place, k: usize) -> f32x8 {
+    fn pixel_pair<const FLIP: bool>(&self, l: &Place, k: usize) -> f32x8 {
         let vertical = |k: usize| {
-            let (below, above) = self.rows_at(l.at(k));
+            let (below, above) = self.rows_at::<FLIP>(l.at(k));
             (above - below)
                 .mul_add(f32x8::splat(l.t[2 * k + 1]), below)
                 .to_array()
@@ -418,11 +420,25 @@ pub(crate) fn row<T: Sample>(
     slow: impl Fn(usize, &mut [f32; 4]),
 ) {
     assert_eq!(positions.len(), out.len(), "one position per pixel");
+    match taps.flipped {
+        true => row_with::<T, true>(taps, positions, out, slow),
+        false => row_with::<T, false>(taps, positions, out, slow),
+    }
+}
+
+/// [`row`] for a buffer stored top row first (`FLIP`) or bottom row first.
+#[inline(always)]
+fn row_with<T: Sample, const FLIP: bool>(
+    taps: &Taps<'_, T>,
+    positions: &[[f32; 2]],
+    out: &mut [[f32; 4]],
+    slow: impl Fn(usize, &mut [f32; 4]),
+) {
     // Pixels `first..` of a located group, one by one.
     let each = |l: &Located, first: usize, outs: &mut [[f32; 4]]| {
         for (k, o) in outs.iter_mut().enumerate() {
             if (l.place.fast >> (2 * k)) & 3 == 3 {
-                *o = taps.pixel(l, k);
+                *o = taps.pixel::<FLIP>(l, k);
             } else {
                 slow(first + k, o);
             }
@@ -434,7 +450,7 @@ pub(crate) fn row<T: Sample>(
         let place = ahead.place(g);
         if PAIRS && place.fast == ALL_FAST && !taps.cubic {
             for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
-                put_pair(o, taps.pixel_pair(place, k));
+                put_pair(o, taps.pixel_pair::<FLIP>(place, k));
             }
         } else {
             each(&taps.located(*place), 4 * g, outs);
@@ -475,6 +491,23 @@ pub(crate) fn blend_row<S: Sample>(
         pa.len() == out.len() && pb.len() == out.len(),
         "one position per pixel and source"
     );
+    let (a, b) = ((a, pa, wa, slow_a), (b, pb, wb, slow_b));
+    match (a.0.flipped, b.0.flipped) {
+        (true, true) => blend_row_with::<S, true, true>(a, b, out),
+        (true, false) => blend_row_with::<S, true, false>(a, b, out),
+        (false, true) => blend_row_with::<S, false, true>(a, b, out),
+        (false, false) => blend_row_with::<S, false, false>(a, b, out),
+    }
+}
+
+/// [`blend_row`] for buffers stored top row first (`FA`, `FB`) or bottom
+/// row first.
+#[inline(always)]
+fn blend_row_with<S: Sample, const FA: bool, const FB: bool>(
+    (a, pa, wa, slow_a): (&Taps<'_, S>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
+    (b, pb, wb, slow_b): (&Taps<'_, S>, &[[f32; 2]], f32, impl Fn(usize) -> [f32; 4]),
+    out: &mut [[f32; 4]],
+) {
     let blend = |va: [f32; 4], vb: [f32; 4]| std::array::from_fn(|c| wb.mul_add(vb[c], wa * va[c]));
     // Pixels `first..` of a located group of each source, one by one.
     let each = |(la, lb): (&Located, &Located), first: usize, outs: &mut [[f32; 4]]| {
@@ -482,11 +515,19 @@ pub(crate) fn blend_row<S: Sample>(
             let fast = |l: &Located| (l.place.fast >> (2 * k)) & 3 == 3;
             let (fast_a, fast_b) = (fast(la), fast(lb));
             *o = if fast_a && fast_b {
-                blend(a.pixel(la, k), b.pixel(lb, k))
+                blend(a.pixel::<FA>(la, k), b.pixel::<FB>(lb, k))
             } else {
                 let n = first + k;
-                let va = if fast_a { a.pixel(la, k) } else { slow_a(n) };
-                let vb = if fast_b { b.pixel(lb, k) } else { slow_b(n) };
+                let va = if fast_a {
+                    a.pixel::<FA>(la, k)
+                } else {
+                    slow_a(n)
+                };
+                let vb = if fast_b {
+                    b.pixel::<FB>(lb, k)
+                } else {
+                    slow_b(n)
+                };
                 blend(va, vb)
             };
         }
@@ -498,7 +539,9 @@ pub(crate) fn blend_row<S: Sample>(
         if PAIRS && la.fast & lb.fast == ALL_FAST && !a.cubic && !b.cubic {
             let (wa8, wb8) = (f32x8::splat(wa), f32x8::splat(wb));
             for (k, o) in [0, 2].into_iter().zip(outs.as_chunks_mut::<2>().0) {
-                let v = b.pixel_pair(lb, k).mul_add(wb8, a.pixel_pair(la, k) * wa8);
+                let v = b
+                    .pixel_pair::<FB>(lb, k)
+                    .mul_add(wb8, a.pixel_pair::<FA>(la, k) * wa8);
                 put_pair(o, v);
             }
         } else {

@@ -71,8 +71,10 @@ fn without_motion_the_midpoint_is_the_plain_average() {
 
 /// The dissolve samples both float RGBA sources of a pixel in one pass; it
 /// must give bit for bit what resampling each source and blending gives,
-/// wherever the positions fall (edges, centres, NaN), with either source in
-/// a top-down buffer, and where a map's window does not cover the output.
+/// wherever the positions fall (edges, centres, NaN), with each source
+/// bottom row first or top row first in memory (each pair of the two is
+/// its own instance of the kernel), and where a map's window does not
+/// cover the output.
 #[test]
 fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
     use crate::image::resample::through;
@@ -87,19 +89,27 @@ fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
             ((i * 2 + j * 11 + c as i32) % 13) as f32 * 0.3 - 0.5
         }),
     );
-    // B top row first in memory.
-    let (w, h) = (b.width() * 4, b.height());
-    let mut top_down = vec![0f32; b.data.len()];
-    for r in 0..h {
-        top_down[(h - 1 - r) * w..(h - r) * w].copy_from_slice(&b.data[r * w..(r + 1) * w]);
-    }
+    // Each plate top row first in memory too.
+    let (w, h) = (a.width() * 4, a.height());
+    let top_down = |img: &Image| {
+        let mut v = vec![0f32; img.data.len()];
+        for r in 0..h {
+            v[(h - 1 - r) * w..(h - r) * w].copy_from_slice(&img.data[r * w..(r + 1) * w]);
+        }
+        v
+    };
     let layout = Layout {
         bounds,
         channels: 4,
         base: (h - 1) * w,
         row_stride: -(w as isize),
     };
-    let b_view = ImageView::new(&top_down, layout).unwrap();
+    let (a_down, b_down) = (top_down(&a), top_down(&b));
+    let a_views = [a.view(), ImageView::new(&a_down, layout).unwrap()];
+    let b_views = [b.view(), ImageView::new(&b_down, layout).unwrap()];
+    let storages = a_views
+        .iter()
+        .flat_map(|&va| b_views.iter().map(move |&vb| (va, vb)));
     let map = |window: RectI, seed| {
         WarpMap::new(
             window,
@@ -112,12 +122,13 @@ fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
         (map(bounds, 1), map(bounds, 2)),
         (map(bounds, 3), map(narrow, 4)),
     ];
-    for ((ma, mb), filter) in maps
-        .iter()
-        .flat_map(|m| [(m, Filter::Bilinear), (m, Filter::Bicubic)])
-    {
+    let cases = storages.flat_map(|views| {
+        maps.iter()
+            .flat_map(move |m| [Filter::Bilinear, Filter::Bicubic].map(|f| (views, m, f)))
+    });
+    for ((va, vb), (ma, mb), filter) in cases {
         let sampler = |view| Sampler::new(view, PixelScale::UNIT, filter, EdgeMode::Clamp, true);
-        let (sa, sb) = (sampler(a.view()), sampler(b_view));
+        let (sa, sb) = (sampler(va), sampler(vb));
         for t in [0.3, 0.75] {
             let mut got = Image::new(bounds, 4);
             dissolve(
