@@ -382,10 +382,29 @@ impl<'a, T: Sample> Sampler<'a, T> {
         }
     }
 
+    /// `Σ w · pixel` over `taps` in their order, each resolved by the
+    /// edge mode (a tap it drops, or of weight zero, adds nothing): the
+    /// one-pixel sum every path falls back on, where the direct path
+    /// leaves the border strip a warp pulls in from outside. One instance
+    /// per channel layout, so a tap's channels are an unrolled loop.
     #[inline]
     fn accumulate(&self, taps: &[(i32, i32, f32)], out: &mut [f32; 4]) {
+        match (self.view.channels(), self.alpha_weighted) {
+            (_, true) => self.accumulate_in::<4, true>(taps, out),
+            (4, false) => self.accumulate_in::<4, false>(taps, out),
+            (3, _) => self.accumulate_in::<3, false>(taps, out),
+            (2, _) => self.accumulate_in::<2, false>(taps, out),
+            _ => self.accumulate_in::<1, false>(taps, out),
+        }
+    }
+
+    #[inline(always)]
+    fn accumulate_in<const C: usize, const AW: bool>(
+        &self,
+        taps: &[(i32, i32, f32)],
+        out: &mut [f32; 4],
+    ) {
         let b = self.view.bounds();
-        let n = self.view.channels();
         let mut acc = [0f32; 4];
         for &(i, j, w) in taps {
             if w == 0.0 {
@@ -397,25 +416,9 @@ impl<'a, T: Sample> Sampler<'a, T> {
             ) else {
                 continue;
             };
-            let px = self.view.pixel(i, j);
-            if self.alpha_weighted {
-                let a = px[3].to_f32();
-                let wa = w * a;
-                for c in 0..3 {
-                    acc[c] += wa * px[c].to_f32();
-                }
-                acc[3] += wa;
-            } else {
-                for c in 0..n {
-                    acc[c] += w * px[c].to_f32();
-                }
-            }
+            add::<T, C, AW>(&mut acc, &self.view.pixel(i, j)[..C], w);
         }
-        *out = if self.alpha_weighted {
-            unweight(acc)
-        } else {
-            acc
-        };
+        *out = if AW { unweight(acc) } else { acc };
     }
 }
 
