@@ -17,11 +17,11 @@
 //! pixels a little ahead are asked of the cache early ([`Taps::prefetch`]);
 //! each group of four is placed once, then ([`Ahead`]), and waits in a
 //! small ring for its turn: placing each group twice (once to prefetch,
-//! once to sample) cost a quarter of the time. Past that both are bound by
-//! each core's own work: on an EPYC a dissolve's pixel takes as long with
-//! every byte in the L2 cache as at 1080p (a warp's taps add 15–30 %), and
-//! its loop keeps the load pipes busiest, the taps under a third of its
-//! vector loads (docs/PERFORMANCE.md).
+//! once to sample) cost a quarter of the time. Past that, on a Xeon both
+//! are bound by the instructions a pixel takes. On an EPYC a dissolve's
+//! pixel takes nearly as long with every byte in cache as at 1080p (a
+//! warp's taps add 15–30 %), and a quarter fewer instructions did not
+//! make it faster (docs/PERFORMANCE.md).
 //!
 //! Bilinear values are bit for bit those of the general path for other
 //! sample types and of the separate blend (the same fused multiply-adds in
