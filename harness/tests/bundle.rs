@@ -164,8 +164,14 @@ impl Default for Case {
 
 const T: f64 = 0.4;
 
-/// Renders the Morph node through the C ABI: (output, source frames as the plugin saw them).
-fn render_morph(case: &Case) -> (Image, Image, Image) {
+/// The Morph node set up for `case`, its sources and the output spec.
+fn morph_node(
+    case: &Case,
+) -> (
+    morphfx_harness::host::Instance<'static>,
+    [Arc<Frame>; 2],
+    OutputSpec,
+) {
     let b = bundle();
     let inst = b
         .instance("net.morphfx.Morph", "OfxImageEffectContextGeneral")
@@ -220,6 +226,12 @@ fn render_morph(case: &Case) -> (Image, Image, Image) {
         interactive: false,
         window: None,
     };
+    (inst, [fa, fb], spec)
+}
+
+/// Renders the Morph node through the C ABI: (output, source frames as the plugin saw them).
+fn render_morph(case: &Case) -> (Image, Image, Image) {
+    let (inst, [fa, fb], spec) = morph_node(case);
     inst.begin_sequence(1.0, 1.0).unwrap();
     let out = inst.render(1.0, spec).unwrap();
     inst.end_sequence(1.0, 1.0).unwrap();
@@ -504,6 +516,58 @@ fn shifted_bounds_and_negative_row_bytes_match_the_core() {
             ..Case::default()
         });
     }
+}
+
+/// Where a frame's samples start in memory, as the plugin is told.
+fn data_pointer(f: &Arc<Frame>) -> usize {
+    let props = f.image_props((1.0, 1.0), 0.0);
+    let data = openfx::sys::image_effect_v1::image_effect::kOfxImagePropData;
+    match props.get(&data.to_string_lossy()) {
+        Some(morphfx_harness::host::props::Value::P(p)) => p[0],
+        other => panic!("no data pointer: {other:?}"),
+    }
+}
+
+/// A frame handed back (`Instance::recycle`) is the next render's output
+/// buffer, as a viewer reuses its buffers, and what it held before is
+/// never read: in a debug build (the tests') every sample is NaN until the
+/// plugin writes it, so a pixel outside a render window reads NaN, not the
+/// last render's pixel. A frame still held elsewhere is not reused.
+#[test]
+fn a_recycled_frame_is_written_into_again_and_unwritten_pixels_read_nan() {
+    let (inst, _sources, spec) = morph_node(&Case::default());
+    let full = inst.render(1.0, spec).unwrap();
+    let (want, at) = (full.to_image(), data_pointer(&full));
+    inst.recycle(full);
+    let again = inst.render(1.0, spec).unwrap();
+    assert_eq!(data_pointer(&again), at, "the frame handed back is reused");
+    let bits = |img: &Image| img.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&again.to_image()), bits(&want));
+    inst.recycle(again);
+    let window = RectI::new(8, 8, 40, 30);
+    let part = OutputSpec {
+        window: Some(window),
+        ..spec
+    };
+    let part = inst.render(1.0, part).unwrap();
+    assert_eq!(data_pointer(&part), at);
+    let got = part.to_image();
+    for j in want.bounds.y1..want.bounds.y2 {
+        for i in want.bounds.x1..want.bounds.x2 {
+            let (g, w) = (got.pixel(i, j), want.pixel(i, j));
+            let inside = (window.x1..window.x2).contains(&i) && (window.y1..window.y2).contains(&j);
+            if inside {
+                assert_eq!(g, w, "({i}, {j}) in the window");
+            } else {
+                let poisoned = g.iter().all(|v| v.is_nan());
+                assert_eq!(poisoned, cfg!(debug_assertions), "({i}, {j}): {g:?}");
+            }
+        }
+    }
+    let held = part.clone();
+    inst.recycle(part);
+    let fresh = inst.render(1.0, spec).unwrap();
+    assert_ne!(data_pointer(&fresh), data_pointer(&held));
 }
 
 #[test]

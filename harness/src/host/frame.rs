@@ -232,6 +232,17 @@ impl Frame {
         }
     }
 
+    /// Every sample NaN (floats) or the depth's largest value (integers):
+    /// what a pixel no render wrote reads as in a debug build.
+    pub fn poison(&mut self) {
+        match self.pixels.get_mut() {
+            Pixels::U8(v) => v.fill(u8::MAX),
+            Pixels::U16(v) => v.fill(u16::MAX),
+            Pixels::F32(v) => v.fill(f32::NAN),
+            Pixels::Lent(_) => {}
+        }
+    }
+
     pub fn depth(&self) -> &'static str {
         // SAFETY: reading the variant only; writers never change it.
         match unsafe { &*self.pixels.get() } {

@@ -77,6 +77,7 @@ impl Bundle {
             plugin,
             _descriptor: descriptor,
             effect,
+            spare: std::sync::Mutex::new(None),
         })
     }
 }
@@ -87,6 +88,9 @@ pub struct Instance<'b> {
     plugin: *const OfxPlugin,
     _descriptor: Box<Effect>,
     pub effect: Box<Effect>,
+    /// A rendered frame handed back ([`Self::recycle`]) for the next
+    /// render of the same shape to write into.
+    spare: std::sync::Mutex<Option<Frame>>,
 }
 
 /// A multi-planar plugin's answer to `GetClipComponents`.
@@ -435,6 +439,9 @@ impl Instance<'_> {
                 ),
             };
             let mut f = Frame::blank(bounds, channels, depth, spec.top_down);
+            if cfg!(debug_assertions) {
+                f.poison(); // as in `output_frame`
+            }
             f.par = self.pixel_aspect();
             frames.push((p.clone(), Arc::new(f)));
         }
@@ -809,7 +816,7 @@ impl Instance<'_> {
                 return Ok(self.pass_through(&clip, at, bounds, spec));
             }
         }
-        let mut out = Frame::blank(bounds, spec.channels, spec.depth, spec.top_down);
+        let mut out = self.output_frame(bounds, spec);
         out.par = self.pixel_aspect();
         let out = Arc::new(out);
         let out_clip = self
@@ -824,6 +831,42 @@ impl Instance<'_> {
         *out_clip.output.locked() = None;
         result?;
         Ok(out)
+    }
+
+    /// Hands a rendered frame back, done with, for the next render of the
+    /// same shape to write into, as a host's viewer reuses its buffers:
+    /// zeroing a fresh buffer for every render cost 5–9 % of a drag's
+    /// renders (docs/PERFORMANCE.md). A frame still shared elsewhere is
+    /// only dropped.
+    pub fn recycle(&self, frame: Arc<Frame>) {
+        if let Ok(f) = Arc::try_unwrap(frame) {
+            *self.spare.locked() = Some(f);
+        }
+    }
+
+    /// The buffer a render's output is written into: the frame last handed
+    /// back ([`Self::recycle`]) when its shape is the same, else a fresh one.
+    ///
+    /// Its pixels are what the plugin must write in full: the spec leaves
+    /// an output image's contents before a render undefined. Debug builds
+    /// (the tests') fill every output buffer with NaN or the integer
+    /// depths' largest value first, so a pixel a plugin leaves unwritten
+    /// shows up as that, not as black or as an earlier render's pixel.
+    fn output_frame(&self, bounds: RectI, spec: OutputSpec) -> Frame {
+        let spare = self.spare.locked().take();
+        let mut frame = spare
+            .filter(|f| {
+                f.bounds == bounds
+                    && f.channels == spec.channels
+                    && f.depth() == spec.depth
+                    && f.top_down == spec.top_down
+            })
+            .unwrap_or_else(|| Frame::blank(bounds, spec.channels, spec.depth, spec.top_down));
+        frame.premultiplied = true;
+        if cfg!(debug_assertions) {
+            frame.poison();
+        }
+        frame
     }
 
     /// What the plugin may ask the host during a render: the field, the

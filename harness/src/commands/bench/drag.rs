@@ -123,11 +123,14 @@ pub fn drag(
             // The scene's text is the host's (a param it holds), not part
             // of what the plugin does after the move: made before the clock.
             let text = scene(size, step);
+            // Each frame is handed back, as a viewer reuses its buffers.
             moved.push(time(&mut || {
                 inst.set_string("scene_text", &text)?;
-                inst.render(1.0, spec).map(|_| ())
+                inst.render(1.0, spec).map(|f| inst.recycle(f))
             })?);
-            still.push(time(&mut || inst.render(1.0, spec).map(|_| ()))?);
+            still.push(time(&mut || {
+                inst.render(1.0, spec).map(|f| inst.recycle(f))
+            })?);
         }
         // What a compositor feels is every render of the drag: the
         // slowest beside the median.
