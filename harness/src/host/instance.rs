@@ -834,10 +834,11 @@ impl Instance<'_> {
     }
 
     /// Hands a rendered frame back, done with, for the next render of the
-    /// same shape to write into, as a host's viewer reuses its buffers:
-    /// zeroing a fresh buffer for every render cost 5–9 % of a drag's
-    /// renders (docs/PERFORMANCE.md). A frame still shared elsewhere is
-    /// only dropped.
+    /// same shape to write into, as a host's viewer reuses its buffers: a
+    /// fresh buffer, zeroed and faulted in page by page, cost 11–25 % of an
+    /// unchanged 1080p frame's time and half a UHD one's
+    /// (docs/PERFORMANCE.md). A frame still shared elsewhere is only
+    /// dropped.
     pub fn recycle(&self, frame: Arc<Frame>) {
         if let Ok(f) = Arc::try_unwrap(frame) {
             *self.spare.locked() = Some(f);
