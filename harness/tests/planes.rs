@@ -174,6 +174,43 @@ fn the_nodes_say_they_make_every_plane_of_their_source() {
     );
 }
 
+/// Every plane's buffer holds NaN in a debug build (the tests') until the
+/// plugin writes it, as the colour output's does: pixels outside a render
+/// window read NaN in each plane, and those inside are the full render's.
+#[test]
+fn unwritten_pixels_of_every_plane_read_nan() {
+    let inst = lined("net.morphfx.Warp", "OfxImageEffectContextFilter");
+    connect_layers(&inst, "Source", 0.0);
+    let full = inst.render_planes(0.0, spec(), &every_plane()).unwrap();
+    let window = RectI::new(8, 8, 40, 30);
+    let part = OutputSpec {
+        window: Some(window),
+        ..spec()
+    };
+    let part = inst.render_planes(0.0, part, &every_plane()).unwrap();
+    for ((plane, want), (_, got)) in full.iter().zip(&part) {
+        let (want, got) = (want.to_image(), got.to_image());
+        for j in want.bounds.y1..want.bounds.y2 {
+            for i in want.bounds.x1..want.bounds.x2 {
+                let (g, w) = (got.pixel(i, j), want.pixel(i, j));
+                let inside =
+                    (window.x1..window.x2).contains(&i) && (window.y1..window.y2).contains(&j);
+                if inside {
+                    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(g), bits(w), "{plane} ({i}, {j}) in the window");
+                } else {
+                    let poisoned = g.iter().all(|v| v.is_nan());
+                    assert_eq!(
+                        poisoned,
+                        cfg!(debug_assertions),
+                        "{plane} ({i}, {j}): {g:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn every_plane_equals_that_plane_warped_alone() {
     let inst = lined("net.morphfx.Warp", "OfxImageEffectContextFilter");
