@@ -411,8 +411,8 @@ impl Moved {
                         RowChange::exact(change.each_ref().map(|v| &v[..]))
                     }
                 };
-                let pixels = (&mut out[cols.clone()], &mut weights[cols.clone()]);
-                if swap_terms(xs, y, &by, pixels, &mut refused) {
+                let (pos, ws) = (&mut out[cols.clone()], &mut weights[cols.clone()]);
+                if swap_terms(xs, y, &by, pos, ws, &mut refused) {
                     continue;
                 }
                 let at = refused[..n].iter().enumerate().filter(|(_, r)| **r);
