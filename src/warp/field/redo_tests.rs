@@ -205,6 +205,33 @@ fn long_drags_with_changes_waiting_far_away_stay_within_tolerance() {
     }
 }
 
+/// What a block's pixels owe is checked in sums against their weights,
+/// and a line dragged close past the block changes those weights (its
+/// terms are swapped in exactly), so the same sums come to move the
+/// positions by more. After every redo of long drags, every block's check
+/// points still owe no more than its allowance.
+#[test]
+fn what_blocks_owe_stays_within_their_allowance_as_lines_pass() {
+    for seed in 0..6u64 {
+        for (scale, by) in [(1.0, v(14.0, 9.0)), (0.5, v(-3.0, 5.0)), (1.0, v(0.7, 0.3))] {
+            let (window, scale) = window_at(scale);
+            let n = 10 + (seed as usize * 7) % 50;
+            let mut pairs = spread_pairs(seed + 100, n, 640.0, 360.0);
+            let mut kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
+            for step in 1..=30u32 {
+                pairs = drag(&pairs, (seed as usize + step as usize / 10) % n, by);
+                let warp = FieldWarp::new(pairs.clone(), &adaptive());
+                kept = warp.field_map_from(window, scale, kept);
+                assert!(
+                    kept.owes_within_allowance(&warp),
+                    "seed {seed}, scale {}, step {by:?} × {step}",
+                    scale.x
+                );
+            }
+        }
+    }
+}
+
 /// A nudge of one line among many rewrites the pixels near it and leaves
 /// those far from it as they were, bit for bit: their share of the change
 /// waits in their blocks' lags.

@@ -293,6 +293,13 @@ impl Lag {
         self.add(samples, &NONE, allowed, true)
     }
 
+    /// Whether what the check points owe (with what is pending, if
+    /// anything) moves none of their positions by more than `allowed` per
+    /// axis, with the pixels as [`Lag::look`] last saw them.
+    pub fn owes_within(&self, samples: &Samples, allowed: [f32; 2]) -> bool {
+        self.within(samples.nodes..samples.len, [&self.due, &NONE], allowed)
+    }
+
     /// Whether leaving the sum of `lag`'s two parts out of the pixels of
     /// the samples in `range` moves none of their positions by more than
     /// `allowed` per axis. One pass with no early exit, which vectorises.

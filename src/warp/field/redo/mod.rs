@@ -18,6 +18,10 @@
 //!   dominates it, and the division would magnify the map's rounding) is
 //!   evaluated exactly with every line; its block afresh when such pixels
 //!   are a quarter of it.
+//! - What a block owes is kept as sums, so it moves the positions by more
+//!   where a write lowered the block's weights (a line dragged close past
+//!   it): a block that owes more than its allowance once written is
+//!   evaluated afresh.
 //!
 //! A redo edits the map before in place when it is handed over
 //! ([`FieldWarp::field_map_from`]), so the pixels it leaves alone cost
@@ -84,6 +88,18 @@ impl FieldMap {
     #[cfg(test)]
     pub(super) fn swaps(&self) -> Vec<u32> {
         self.lags.iter().map(|t| t.swaps).collect()
+    }
+
+    /// Whether what every block's pixels have not taken moves none of its
+    /// check points by more than its allowance: what a redo holds, as
+    /// `warp` (this map's) would check it.
+    #[cfg(test)]
+    pub(super) fn owes_within_allowance(&self, warp: &FieldWarp) -> bool {
+        let setup = warp.setup(self.map.window, self.map.scale);
+        self.lags.iter().all(|t| {
+            let owes = |a| t.lag.owes_within(&t.samples, a);
+            allowed(&setup, t).is_none_or(owes)
+        })
     }
 
     /// Heap bytes held (for cache budgets).
@@ -300,14 +316,21 @@ impl Moved {
         for (k, (tracked, step)) in lags.iter_mut().zip(steps).enumerate() {
             match step {
                 Step::Untouched => continue,
-                Step::Fresh => {
-                    tracked.made = band.block(k).fill();
-                    tracked.lag = Lag::default();
-                    tracked.swaps = 0;
+                Step::Fresh => renew(band, k, tracked),
+                Step::Swap { .. } => {
+                    tracked.swaps += 1;
+                    tracked.lag.look(band, &tracked.samples);
+                    // What the check points owe was checked in sums
+                    // against the pixels' weights before this write. The
+                    // write changed them (a line passing close changes
+                    // them most), and where `Σ w` fell the same sums now
+                    // move the positions by more.
+                    let owes = |a| tracked.lag.owes_within(&tracked.samples, a);
+                    if !allowed(band.setup, tracked).is_none_or(owes) {
+                        renew(band, k, tracked);
+                    }
                 }
-                Step::Swap { .. } => tracked.swaps += 1,
             }
-            tracked.lag.look(band, &tracked.samples);
         }
     }
 
@@ -321,11 +344,10 @@ impl Moved {
     /// evaluation's far lines, the change is known from the block's grid
     /// and waits in its [`Lag`] until it matters.
     fn plan(&self, band: &Band, k: usize, tracked: &mut Tracked) -> Option<Plan> {
-        let Some(tol) = band.setup.tolerance() else {
+        let Some(allowed) = allowed(band.setup, tracked) else {
             return Some(Plan::Exact(None));
         };
         let (lag, samples) = (&mut tracked.lag, &tracked.samples);
-        let allowed = std::array::from_fn(|a| (tol[a] - tracked.made[a]).max(0.0) * lag::SHARE);
         let (lo, hi) = corners(band.rect(k));
         let close = |&(p, q): &(Vec2, Vec2)| is_within(p, q, lo, hi, CLOSE);
         if !self.segments.iter().any(close) {
@@ -456,6 +478,24 @@ impl Moved {
             weights.expect("a redo keeps weights")[i] = ow[k];
         }
     }
+}
+
+/// Block `k` of `band` evaluated afresh, its lag empty.
+fn renew(band: &mut Band, k: usize, tracked: &mut Tracked) {
+    tracked.made = band.block(k).fill();
+    tracked.lag = Lag::default();
+    tracked.swaps = 0;
+    tracked.lag.look(band, &tracked.samples);
+}
+
+/// How far, per axis, what a block's pixels have not taken may move their
+/// positions: the share of what its own error left of the tolerance
+/// (`None` for an exact evaluation).
+fn allowed(setup: &Setup, tracked: &Tracked) -> Option<[f32; 2]> {
+    let tol = setup.tolerance()?;
+    Some(std::array::from_fn(|a| {
+        (tol[a] - tracked.made[a]).max(0.0) * lag::SHARE
+    }))
 }
 
 /// What becomes of a block in a redo.
