@@ -168,11 +168,8 @@ fn maps_are_made_afresh_when_the_setup_or_many_lines_change() {
 }
 
 /// Long drags of many lines at both scales, with small and large steps:
-/// what waits in the blocks' lags, and what their pixels took from a grid,
-/// keeps every map within tolerance of the exact one.
-#[test]
-fn long_drags_with_changes_waiting_far_away_stay_within_tolerance() {
-    let tolerance = Evaluation::DEFAULT_TOLERANCE;
+/// `check(case, map, warp, step)` after every redo, `case` naming the drag.
+fn long_drags(mut check: impl FnMut(&str, &FieldMap, &FieldWarp, u32)) {
     for seed in 0..6u64 {
         let steps = [
             (1.0, v(0.7, 0.3)),
@@ -190,19 +187,28 @@ fn long_drags_with_changes_waiting_far_away_stay_within_tolerance() {
                 let warp = FieldWarp::new(pairs.clone(), &adaptive());
                 assert!(warp.redoes(window, scale, &kept));
                 kept = warp.field_map_from(window, scale, kept);
-                if step % 10 == 0 {
-                    let truth =
-                        FieldWarp::new(pairs.clone(), &exact(0.001)).map_window(window, scale);
-                    let err = worst_px(kept.map(), &truth);
-                    assert!(
-                        err <= tolerance,
-                        "seed {seed}, scale {}, step {by:?} × {step}: {err} px > {tolerance}",
-                        scale.x
-                    );
-                }
+                let case = format!("seed {seed}, scale {}, step {by:?} × {step}", scale.x);
+                check(&case, &kept, &warp, step);
             }
         }
     }
+}
+
+/// What waits in the blocks' lags, and what their pixels took from a grid,
+/// keeps every map of long drags within tolerance of the exact one.
+#[test]
+fn long_drags_with_changes_waiting_far_away_stay_within_tolerance() {
+    let tolerance = Evaluation::DEFAULT_TOLERANCE;
+    long_drags(|case, kept, warp, step| {
+        if step % 10 == 0 {
+            let exact = FieldWarp::new(warp.pairs().to_vec(), &exact(0.001));
+            let err = worst_px(
+                kept.map(),
+                &exact.map_window(kept.map().window, kept.map().scale),
+            );
+            assert!(err <= tolerance, "{case}: {err} px > {tolerance}");
+        }
+    });
 }
 
 /// What a block's pixels owe is checked in sums against their weights,
@@ -212,24 +218,9 @@ fn long_drags_with_changes_waiting_far_away_stay_within_tolerance() {
 /// points still owe no more than its allowance.
 #[test]
 fn what_blocks_owe_stays_within_their_allowance_as_lines_pass() {
-    for seed in 0..6u64 {
-        for (scale, by) in [(1.0, v(14.0, 9.0)), (0.5, v(-3.0, 5.0)), (1.0, v(0.7, 0.3))] {
-            let (window, scale) = window_at(scale);
-            let n = 10 + (seed as usize * 7) % 50;
-            let mut pairs = spread_pairs(seed + 100, n, 640.0, 360.0);
-            let mut kept = FieldWarp::new(pairs.clone(), &adaptive()).field_map(window, scale);
-            for step in 1..=30u32 {
-                pairs = drag(&pairs, (seed as usize + step as usize / 10) % n, by);
-                let warp = FieldWarp::new(pairs.clone(), &adaptive());
-                kept = warp.field_map_from(window, scale, kept);
-                assert!(
-                    kept.owes_within_allowance(&warp),
-                    "seed {seed}, scale {}, step {by:?} × {step}",
-                    scale.x
-                );
-            }
-        }
-    }
+    long_drags(|case, kept, warp, _| {
+        assert!(kept.owes_within_allowance(warp), "{case}");
+    });
 }
 
 /// A nudge of one line among many rewrites the pixels near it and leaves
