@@ -15,11 +15,13 @@ use super::super::split::{Band, BLOCK};
 use crate::geom::{PixelScale, RectI};
 
 /// Spacing of the grid a far change is known on, pixels. Its cells are
-/// as wide as a quarter of [`NEAR`](super::super::split::NEAR) at most
-/// (relative curvature of a far term over one: `0.75·(8/128)² ≈ 3e-3`),
-/// and the pixels take a change only once it is about the share
-/// allowed, so what interpolating it misses is a small part of that.
-pub(super) const SPACING: i32 = 8;
+/// an eighth of [`NEAR`](super::super::split::NEAR) wide (relative
+/// curvature of a far term over one: `0.75·(16/128)² ≈ 0.012`), and the
+/// check points at their centres and their edges' centres find what
+/// interpolating it misses, so a block takes the change once
+/// that would be too much. A third of the samples of an 8 px grid: the
+/// lags are most of what a redo reads for the blocks it leaves alone.
+pub(super) const SPACING: i32 = 16;
 /// Grid nodes of a whole block, across or up.
 const NODES_ACROSS: usize = (BLOCK / SPACING) as usize + 1;
 /// Grid nodes of a whole block.
