@@ -334,6 +334,22 @@ const NONE: Change = [[0.0; PADDED]; 3];
 mod tests {
     use super::*;
 
+    /// A far change is known on a 16 px grid (docs/architecture.md): a
+    /// whole block's nodes lie 16 pixels apart, across and up.
+    #[test]
+    fn a_whole_blocks_grid_has_its_nodes_16_px_apart() {
+        let block = RectI::new(0, 0, BLOCK, BLOCK);
+        let samples = Samples::of(block, PixelScale::UNIT);
+        let (nodes, nx) = grid::node_count(block, SPACING);
+        assert_eq!(
+            (nx, nodes),
+            (BLOCK as usize / 16 + 1, (BLOCK as usize / 16 + 1).pow(2))
+        );
+        let (xs, ys) = samples.positions();
+        assert_eq!((xs[1] - xs[0], ys[1] - ys[0]), (16.0, 0.0));
+        assert_eq!((xs[nx] - xs[0], ys[nx] - ys[0]), (0.0, 16.0));
+    }
+
     /// The samples of a whole block and of blocks cut short by the
     /// window's edges: the nodes first, row by row as a grid holds them,
     /// then check points each placed in the cell whose centre or edge it
