@@ -41,17 +41,17 @@ def plate(seed):
 
 
 def numpy_huge_pages():
-    """Whether numpy advises 2 MB pages for its large arrays (None: unknown)."""
+    """Whether numpy asks for 2 MB pages for its large arrays, in words."""
     try:
         from numpy._core.multiarray import _set_madvise_hugepage
     except ImportError:
         try:
             from numpy.core.multiarray import _set_madvise_hugepage
         except ImportError:
-            return None
+            return "unknown"
     on = _set_madvise_hugepage(True)
     _set_madvise_hugepage(on)
-    return on
+    return "asked" if on else "not asked"
 
 
 class Timed:
@@ -94,8 +94,8 @@ def main(directory):
 
         print(f"2 x remap + addWeighted {name}: {Timed(morph_into)}"
               f"; fresh arrays: {Timed(morph_fresh)}")
-    print(f"threads: {cv2.getNumThreads()}; numpy's arrays on huge pages: "
-          f"{ {True: 'asked', False: 'not asked', None: 'unknown'}[numpy_huge_pages()] }")
+    print(f"threads: {cv2.getNumThreads()}; "
+          f"numpy's arrays on huge pages: {numpy_huge_pages()}")
 
 
 if __name__ == "__main__":
