@@ -17,11 +17,12 @@
 //! pixels a little ahead are asked of the cache early ([`Taps::prefetch`]);
 //! each group of four is placed once, then ([`Ahead`]), and waits in a
 //! small ring for its turn: placing each group twice (once to prefetch,
-//! once to sample) cost a quarter of the time. Past that, on a Xeon both
-//! are bound by the instructions a pixel takes. On an EPYC a dissolve's
-//! pixel takes nearly as long with every byte in cache as at 1080p (a
-//! warp's taps add 15–30 %), and a quarter fewer instructions did not
-//! make it faster (docs/PERFORMANCE.md).
+//! once to sample) cost a quarter of the time. The positions themselves
+//! are asked for a few groups before they are placed. Past that, on a
+//! Xeon both are bound by the instructions a pixel takes. On an EPYC a
+//! dissolve's pixel takes nearly as long with every byte in cache as at
+//! 1080p (a warp's taps add 15–30 %), and a quarter fewer instructions
+//! did not make it faster (docs/PERFORMANCE.md).
 //!
 //! Bilinear values are bit for bit those of the general path for other
 //! sample types and of the separate blend (the same fused multiply-adds in
@@ -49,6 +50,12 @@ pub(crate) const SNAP: f32 = 1e-4;
 /// memory latency. Measured against 8 and 32 in docs/PERFORMANCE.md (8
 /// was best while each group was located twice, and slower since).
 const AHEAD: usize = 16;
+
+/// How many groups past the one [`Ahead::pass`] places it asks the cache for
+/// positions: the map streams, yet on a Zen 5 EPYC a dissolve spent a fifth
+/// of its time waiting on the map's lines until they were asked for a few
+/// groups early (1 to 12 groups all did as well; docs/PERFORMANCE.md).
+const POSITIONS_AHEAD: usize = 4;
 
 const _: () = assert!(
     cfg!(target_endian = "little"),
@@ -387,9 +394,14 @@ impl<'s, 'a, T: Sample> Ahead<'s, 'a, T> {
         &self.ring[g % AHEAD]
     }
 
-    /// Done with group `g`: group `g + AHEAD` is placed in its slot.
+    /// Done with group `g`: group `g + AHEAD` is placed in its slot, and
+    /// the positions of a group [`POSITIONS_AHEAD`] past it are asked of
+    /// the cache.
     #[inline(always)]
     fn pass(&mut self, g: usize) {
+        if let Some(p) = self.groups.get(g + AHEAD + POSITIONS_AHEAD) {
+            prefetch(p);
+        }
         if let Some(p) = self.groups.get(g + AHEAD) {
             let slot = &mut self.ring[g % AHEAD];
             *slot = self.taps.place(p);
