@@ -20,6 +20,7 @@ pub mod geom;
 pub mod image;
 pub mod make_warp;
 pub mod morph;
+mod prefetch;
 pub mod scene;
 pub mod shutter;
 pub mod snake;

@@ -9,6 +9,8 @@ const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("geom", 0),
     ("choice", 0),
+    // Cache hints for the resample and the field map's redo.
+    ("prefetch", 0),
     ("shutter", 1),
     ("strokes", 1),
     ("features", 1),

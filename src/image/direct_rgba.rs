@@ -38,6 +38,7 @@ use wide::{f32x8, i32x8, u32x8, u64x4};
 
 use super::{Layout, Sample};
 use crate::geom::{PixelScale, RectI};
+use crate::prefetch;
 
 /// Fractions this close to a pixel centre snap to it, so warps that land on
 /// centres up to float round-off copy pixels exactly instead of blurring.
@@ -69,16 +70,6 @@ const ALL_FAST: u32 = 0xff;
 /// where eight-wide `mul_add` is the fused operation scalar `f32::mul_add`
 /// is, so both give the same bits.
 const PAIRS: bool = cfg!(target_feature = "fma");
-
-/// Asks the cache for the line holding `v`: a hint only, and none on
-/// targets where no safe prefetch wrapper exists.
-#[inline(always)]
-fn prefetch<T>(v: &T) {
-    #[cfg(target_arch = "x86_64")]
-    safe_arch::prefetch_t0(v);
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = v;
-}
 
 /// A source sampled by direct addressing; see [`Taps::new`].
 #[derive(Clone, Copy)]
@@ -268,7 +259,7 @@ impl<'a, T: Sample> Taps<'a, T> {
         let tops = tops.min(last).to_array();
         for k in 0..4 {
             if let Some(v) = self.data.get(tops[2 * k] as usize) {
-                prefetch(v);
+                prefetch::line(v);
             }
         }
     }
@@ -400,7 +391,7 @@ impl<'s, 'a, T: Sample> Ahead<'s, 'a, T> {
     #[inline(always)]
     fn pass(&mut self, g: usize) {
         if let Some(p) = self.groups.get(g + AHEAD + POSITIONS_AHEAD) {
-            prefetch(p);
+            prefetch::line(p);
         }
         if let Some(p) = self.groups.get(g + AHEAD) {
             let slot = &mut self.ring[g % AHEAD];

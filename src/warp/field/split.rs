@@ -17,6 +17,7 @@ use super::kernel::{Lines, Sums};
 use super::warp::FieldWarp;
 use crate::geom::{PixelScale, RectI, Vec2};
 use crate::image::WarpMap;
+use crate::prefetch;
 
 /// Side of a block, pixels.
 pub(super) const BLOCK: i32 = 48;
@@ -195,6 +196,20 @@ impl Band<'_> {
         let w = self.setup.window.width();
         let k = (j - self.y1) as usize * w + (i - self.setup.window.x1) as usize;
         (self.out[k], self.weights.as_ref().map_or(0.0, |ws| ws[k]))
+    }
+
+    /// Asks the cache for row `j`'s pixels at columns `cols` of the window
+    /// (positions and `Σ w`), when the band holds that row.
+    pub fn prefetch_row(&self, j: i32, cols: std::ops::Range<usize>) {
+        if !(self.y1..self.y2).contains(&j) {
+            return;
+        }
+        let start = (j - self.y1) as usize * self.setup.window.width();
+        let at = start + cols.start..start + cols.end;
+        prefetch::lines(&self.out[at.clone()]);
+        if let Some(ws) = &self.weights {
+            prefetch::lines(&ws[at]);
+        }
     }
 
     /// Row `j` across the window: positions and `Σ w` (when kept).
