@@ -127,3 +127,32 @@ fn the_scan_sees_known_uses() {
         .iter()
         .any(|(m, u, _)| m == "scene" && u == "make_warp"));
 }
+
+/// The layer table in docs/architecture.md names every module (but the
+/// test helpers) at the layer this scan holds it to.
+#[test]
+fn the_documented_layers_are_the_checked_ones() {
+    let doc = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/architecture.md");
+    let text = std::fs::read_to_string(doc).expect("read docs/architecture.md");
+    let mut documented = Vec::new();
+    for row in text.lines().filter_map(|l| l.strip_prefix("| ")) {
+        let mut cells = row.split(" | ");
+        let (Some(n), Some(modules)) = (cells.next(), cells.next()) else {
+            continue;
+        };
+        let Ok(n) = n.trim().parse::<u32>() else {
+            continue;
+        };
+        for name in modules.split(", ") {
+            documented.push((name.trim().trim_matches('`').to_owned(), n));
+        }
+    }
+    let mut checked: Vec<(String, u32)> = LAYERS
+        .iter()
+        .filter(|(m, _)| *m != "testing")
+        .map(|(m, l)| (m.to_string(), *l))
+        .collect();
+    documented.sort();
+    checked.sort();
+    assert_eq!(documented, checked);
+}
