@@ -193,8 +193,7 @@ impl Band<'_> {
 
     /// Pixel `(i, j)`'s position and `Σ w` (0 when not kept).
     pub fn at(&self, i: i32, j: i32) -> ([f32; 2], f32) {
-        let w = self.setup.window.width();
-        let k = (j - self.y1) as usize * w + (i - self.setup.window.x1) as usize;
+        let k = self.row_start(j) + (i - self.setup.window.x1) as usize;
         (self.out[k], self.weights.as_ref().map_or(0.0, |ws| ws[k]))
     }
 
@@ -204,7 +203,7 @@ impl Band<'_> {
         if !(self.y1..self.y2).contains(&j) {
             return;
         }
-        let start = (j - self.y1) as usize * self.setup.window.width();
+        let start = self.row_start(j);
         let at = start + cols.start..start + cols.end;
         prefetch::lines(&self.out[at.clone()]);
         if let Some(ws) = &self.weights {
@@ -214,9 +213,14 @@ impl Band<'_> {
 
     /// Row `j` across the window: positions and `Σ w` (when kept).
     pub fn row_mut(&mut self, j: i32) -> (&mut [[f32; 2]], Option<&mut [f32]>) {
-        let w = self.setup.window.width();
-        let start = (j - self.y1) as usize * w;
-        row_slices(self.out, self.weights.as_deref_mut(), start..start + w)
+        let start = self.row_start(j);
+        let at = start..start + self.setup.window.width();
+        row_slices(self.out, self.weights.as_deref_mut(), at)
+    }
+
+    /// Where row `j` starts in the band's buffers.
+    fn row_start(&self, j: i32) -> usize {
+        (j - self.y1) as usize * self.setup.window.width()
     }
 }
 
