@@ -1,7 +1,14 @@
-//! The Catmull-Rom (a = −0.5) filter's weights, shared by the general
-//! sampler and the direct float RGBA path.
+//! The filters' arithmetic shared by the general sampler and the direct
+//! float RGBA path: a position's integer part and fraction, snapped near
+//! pixel centres, and the Catmull-Rom (a = −0.5) weights.
 
 use wide::f32x8;
+
+/// Fractions this close to a pixel centre snap to it, so warps that land on
+/// centres up to float round-off copy pixels exactly instead of blurring.
+/// The direct path's four-at-a-time loop leaves positions this close to
+/// its one-pixel path, which snaps them as the general sampler does.
+pub(crate) const SNAP: f32 = 1e-4;
 
 /// [`catmull_rom_weights`] for eight fractions at once.
 #[inline(always)]
@@ -29,4 +36,25 @@ pub(crate) fn catmull_rom_weights(t: f32) -> [f32; 4] {
         0.5 * (-3.0 * t3 + 4.0 * t2 + t),
         0.5 * (t3 - t2),
     ]
+}
+
+/// Integer part and fraction, with fractions within [`SNAP`] of a centre snapped.
+#[inline]
+pub(crate) fn split(f: f32) -> (i32, f32) {
+    // Beyond 2^24 f32 holds no fraction; clamping keeps the integer part in
+    // i32 range. A cast-and-correct floor: `f32::floor` is a libm call on
+    // baseline x86-64.
+    let f = f.clamp(-16_777_216.0, 16_777_216.0);
+    let mut i = f as i32;
+    if i as f32 > f {
+        i -= 1;
+    }
+    let t = f - i as f32;
+    if t < SNAP {
+        (i, 0.0)
+    } else if t > 1.0 - SNAP {
+        (i + 1, 0.0)
+    } else {
+        (i, t)
+    }
 }

@@ -3,8 +3,8 @@
 
 use wide::f32x8;
 
-use super::direct_rgba::{self, Taps, SNAP};
-use super::kernel::{catmull_rom_weights, catmull_rom_weights8};
+use super::direct_rgba::{self, Taps};
+use super::kernel::{catmull_rom_weights, catmull_rom_weights8, split, SNAP};
 use super::{ImageView, Sample};
 use crate::choice::Choice;
 use crate::geom::{PixelScale, RectI};
@@ -73,6 +73,20 @@ impl EdgeMode {
                 let m = (k - lo).rem_euclid(2 * n);
                 Some(lo + if m < n { m } else { 2 * n - 1 - m })
             }
+        }
+    }
+
+    /// [`Self::resolve`] as an index to read, always inside `[lo, hi)`
+    /// (which must not be empty), and whether the tap counts (`false`
+    /// where `resolve` drops it): for black and clamp with no branch,
+    /// as an edge pixel's taps fall either side of the edge.
+    #[inline(always)]
+    pub(crate) fn read(self, k: i32, lo: i32, hi: i32) -> (i32, bool) {
+        let clamped = k.max(lo).min(hi - 1);
+        match self {
+            EdgeMode::Black => (clamped, clamped == k),
+            EdgeMode::Clamp => (clamped, true),
+            EdgeMode::Mirror => (self.resolve(k, lo, hi).unwrap_or(clamped), true),
         }
     }
 }
@@ -149,7 +163,7 @@ impl<'a, T: Sample> Sampler<'a, T> {
         }
         let cubic = self.filter == Filter::Bicubic;
         let (data, layout) = (self.view.data, self.view.layout);
-        Taps::new(data, self.view.bounds(), layout, self.scale(), cubic)
+        Taps::new(data, layout, self.scale(), self.edge, cubic)
     }
 
     /// Whether colour is weighted by alpha while filtering (straight RGBA).
@@ -467,27 +481,6 @@ fn unweight(acc: [f32; 4]) -> [f32; 4] {
     [acc[0] * inv, acc[1] * inv, acc[2] * inv, sum_wa]
 }
 
-/// Integer part and fraction, with fractions within [`SNAP`] of a centre snapped.
-#[inline]
-fn split(f: f32) -> (i32, f32) {
-    // Beyond 2^24 f32 holds no fraction; clamping keeps the integer part in
-    // i32 range. A cast-and-correct floor: `f32::floor` is a libm call on
-    // baseline x86-64.
-    let f = f.clamp(-16_777_216.0, 16_777_216.0);
-    let mut i = f as i32;
-    if i as f32 > f {
-        i -= 1;
-    }
-    let t = f - i as f32;
-    if t < SNAP {
-        (i, 0.0)
-    } else if t > 1.0 - SNAP {
-        (i + 1, 0.0)
-    } else {
-        (i, t)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -512,6 +505,23 @@ mod tests {
         assert_eq!(EdgeMode::Mirror.resolve(4, 0, 4), Some(3));
         assert_eq!(EdgeMode::Mirror.resolve(5, 0, 4), Some(2));
         assert_eq!(EdgeMode::Mirror.resolve(5, 2, 6), Some(5));
+    }
+
+    /// `read` is `resolve` with a readable index where it drops the tap.
+    #[test]
+    fn edge_modes_read_what_they_resolve() {
+        for mode in [EdgeMode::Black, EdgeMode::Clamp, EdgeMode::Mirror] {
+            for (lo, hi) in [(0, 1), (0, 4), (-3, 5)] {
+                for k in -20..20 {
+                    let (at, counts) = mode.read(k, lo, hi);
+                    assert!((lo..hi).contains(&at), "{mode:?} {k} in [{lo}, {hi}): {at}");
+                    match mode.resolve(k, lo, hi) {
+                        Some(r) => assert_eq!((at, counts), (r, true), "{mode:?} {k}"),
+                        None => assert!(!counts, "{mode:?} {k}"),
+                    }
+                }
+            }
+        }
     }
 
     /// The row path (eight positions at a time, per-layout fast paths) must
