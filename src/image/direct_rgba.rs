@@ -37,8 +37,9 @@
 use wide::bytemuck::cast;
 use wide::{f32x4, f32x8, i32x8, u32x4, u32x8, u64x4};
 
+use super::edge::EdgeMode;
 use super::kernel::{split, SNAP};
-use super::{EdgeMode, Layout, Sample};
+use super::{Layout, Sample};
 use crate::geom::{PixelScale, RectI};
 use crate::prefetch;
 

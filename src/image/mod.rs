@@ -6,15 +6,17 @@
 //! `(i, j)` of `bounds` starts at `base + (j - y1) * row_stride + (i - x1) * channels`.
 
 pub(crate) mod direct_rgba;
+mod edge;
 mod kernel;
 mod layer_names;
 pub mod resample;
 mod sample;
 mod warp_map;
 
+pub use edge::EdgeMode;
 pub use layer_names::holds_ids;
 pub use resample::{resample, ResampleSettings};
-pub use sample::{EdgeMode, Filter, Sampler};
+pub use sample::{Filter, Sampler};
 pub use warp_map::WarpMap;
 
 use crate::error::{Error, Result};
