@@ -2,7 +2,7 @@
 //! and benchmarks (the core's, the harness's and the bundle's).
 
 use crate::geom::{RectI, Vec2};
-use crate::image::Image;
+use crate::image::{Image, Layout, Sample};
 
 /// An RGBA plate of `bounds` with a vertical step edge at canonical x =
 /// `edge` (0.1 left of it, 0.9 right, opaque), for snakes to find.
@@ -16,6 +16,33 @@ pub fn step_plate(bounds: RectI, edge: f64) -> Image {
             0.9
         }
     })
+}
+
+/// The pixels of `packed` (rows of `bounds`, `channels` samples a pixel,
+/// bottom row first) laid out as a host may lend them: top row first, `pad`
+/// samples after each row and `lead` before the first, every gap holding
+/// `gap` (NaN shows a read that strays into one).
+pub fn top_down<T: Sample>(
+    packed: &[T],
+    bounds: RectI,
+    channels: usize,
+    (pad, lead): (usize, usize),
+    gap: T,
+) -> (Vec<T>, Layout) {
+    let (w, h) = (bounds.width() * channels, bounds.height());
+    let stride = w + pad;
+    let mut data = vec![gap; lead + h * stride];
+    for (r, row) in packed.chunks_exact(w).enumerate() {
+        let at = lead + (h - 1 - r) * stride;
+        data[at..at + w].copy_from_slice(row);
+    }
+    let layout = Layout {
+        bounds,
+        channels,
+        base: lead + (h - 1) * stride,
+        row_stride: -(stride as isize),
+    };
+    (data, layout)
 }
 
 /// Positions that exercise every path of a sampler row: inside (most), on and

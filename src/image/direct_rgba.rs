@@ -699,21 +699,9 @@ mod tests {
     }
 
     fn check<T: Sample>(bounds: RectI, packed: &[T]) {
-        let (w, h) = (bounds.width(), bounds.height());
         // Top row first, padded rows, a lead-in: as hosts lend buffers.
-        let (pad, lead) = (12, 9);
-        let stride = w * 4 + pad;
-        let mut flipped = vec![T::default(); lead + h * stride];
-        for r in 0..h {
-            let at = lead + (h - 1 - r) * stride;
-            flipped[at..at + w * 4].copy_from_slice(&packed[r * w * 4..(r + 1) * w * 4]);
-        }
-        let top_down = Layout {
-            bounds,
-            channels: 4,
-            base: lead + (h - 1) * stride,
-            row_stride: -(stride as isize),
-        };
+        let (flipped, top_down) =
+            crate::testing::top_down(packed, bounds, 4, (12, 9), T::default());
         let views = [
             ImageView::new(packed, Layout::packed(bounds, 4)).unwrap(),
             ImageView::new(&flipped, top_down).unwrap(),

@@ -12,18 +12,7 @@ fn ramp(bounds: RectI) -> Image {
 fn negative_stride_views_read_the_same_pixels() {
     let img = ramp(RectI::new(5, -3, 13, 4));
     // Same pixels, top row first in memory.
-    let (w, h, c) = (img.width(), img.height(), 4);
-    let mut flipped = vec![0f32; img.data.len()];
-    for r in 0..h {
-        flipped[(h - 1 - r) * w * c..(h - r) * w * c]
-            .copy_from_slice(&img.data[r * w * c..(r + 1) * w * c]);
-    }
-    let layout = Layout {
-        bounds: img.bounds,
-        channels: 4,
-        base: (h - 1) * w * c,
-        row_stride: -((w * c) as isize),
-    };
+    let (flipped, layout) = crate::testing::top_down(&img.data, img.bounds, 4, (0, 0), 0.0);
     let view = ImageView::new(&flipped, layout).unwrap();
     for j in img.bounds.y1..img.bounds.y2 {
         for i in img.bounds.x1..img.bounds.x2 {
@@ -150,21 +139,8 @@ fn direct_float_rgba_sampling_reads_any_layout_exactly() {
     let img = Image::from_fn(bounds, 4, |i, j, c| {
         ((i * 37 + j * 101 + c as i32 * 7) % 97) as f32 / 97.0 - 0.3
     });
-    let (w, h) = (img.width(), img.height());
     // Top row first, 5 pixels of padding per row, 11 samples of lead-in.
-    let (pad, lead) = (20, 11);
-    let stride = w * 4 + pad;
-    let mut flipped = vec![f32::NAN; lead + h * stride];
-    for r in 0..h {
-        let at = lead + (h - 1 - r) * stride;
-        flipped[at..at + w * 4].copy_from_slice(&img.data[r * w * 4..(r + 1) * w * 4]);
-    }
-    let layout = Layout {
-        bounds,
-        channels: 4,
-        base: lead + (h - 1) * stride,
-        row_stride: -(stride as isize),
-    };
+    let (flipped, layout) = crate::testing::top_down(&img.data, bounds, 4, (20, 11), f32::NAN);
     let flipped = ImageView::new(&flipped, layout).unwrap();
     let positions = crate::testing::awkward_positions(bounds, 1003, 5);
     let filters = [Filter::Bilinear, Filter::Bicubic];

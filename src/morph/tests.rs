@@ -78,7 +78,7 @@ fn without_motion_the_midpoint_is_the_plain_average() {
 #[test]
 fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
     use crate::image::resample::through;
-    use crate::image::{ImageView, Layout};
+    use crate::image::ImageView;
     use crate::testing::awkward_positions;
     let bounds = RectI::new(-5, 2, 41, 31);
     let (a, b) = (
@@ -90,21 +90,8 @@ fn one_pass_dissolve_equals_resampling_each_source_then_blending() {
         }),
     );
     // Each plate top row first in memory too.
-    let (w, h) = (a.width() * 4, a.height());
-    let top_down = |img: &Image| {
-        let mut v = vec![0f32; img.data.len()];
-        for r in 0..h {
-            v[(h - 1 - r) * w..(h - r) * w].copy_from_slice(&img.data[r * w..(r + 1) * w]);
-        }
-        v
-    };
-    let layout = Layout {
-        bounds,
-        channels: 4,
-        base: (h - 1) * w,
-        row_stride: -(w as isize),
-    };
-    let (a_down, b_down) = (top_down(&a), top_down(&b));
+    let top_down = |img: &Image| crate::testing::top_down(&img.data, bounds, 4, (0, 0), 0.0);
+    let ((a_down, layout), (b_down, _)) = (top_down(&a), top_down(&b));
     let a_views = [a.view(), ImageView::new(&a_down, layout).unwrap()];
     let b_views = [b.view(), ImageView::new(&b_down, layout).unwrap()];
     let storages = a_views
