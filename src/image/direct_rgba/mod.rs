@@ -100,12 +100,11 @@ pub(crate) struct Taps<'a, T> {
     hi: f32x8,
     /// Catmull-Rom's four taps per axis, else bilinear's two.
     cubic: bool,
-    /// What [`off_path`] needs: the source's bounds, the index of its
-    /// corner pixel, what lies outside, and the scale.
+    /// What [`off_path`] needs besides: the source's bounds, the index of
+    /// its corner pixel, and what lies outside.
     bounds: RectI,
     corner: i32,
     edge: EdgeMode,
-    unit: [f32; 2],
 }
 
 /// Where four positions (one eight-wide vector of x, y pairs) fall in a
@@ -185,7 +184,6 @@ impl<'a, T: Sample> Taps<'a, T> {
             bounds: b,
             corner: base,
             edge,
-            unit: [scale.x as f32, scale.y as f32],
         })
     }
 

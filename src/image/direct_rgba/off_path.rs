@@ -23,20 +23,20 @@ impl<T: Sample> Taps<'_, T> {
 
     /// The bilinear value at canonical position `[x, y]` wherever the fast
     /// path does not take it (taps past an edge, on or near a centre line,
-    /// not finite): bit for bit [`crate::image::Sampler::sample`], whose steps it
-    /// takes (the same split and weights, each tap's product added in turn
-    /// to a sum from zero, a tap the edge drops or of weight zero skipped),
-    /// four channels at once, each axis's two taps resolved once, and a
-    /// select where that takes a branch: an edge pixel's taps fall either
-    /// side of the edge, so those branches went either way. Out of line:
-    /// under 1 % of a warp's pixels come here, and the fast loop stays
-    /// small.
+    /// not finite): bit for bit [`crate::image::Sampler::sample`], whose
+    /// steps it takes (the same split and weights, each tap's product added
+    /// in turn to a sum from zero, a tap the edge drops or of weight zero
+    /// skipped), four channels at once, each axis's two taps resolved
+    /// once, and a select where that takes a branch: an edge pixel's taps
+    /// fall either side of the edge, so those branches went either way.
+    /// Out of line: under 1 % of a warp's pixels come here, and the fast
+    /// loop stays small.
     #[inline(never)]
     fn bilinear_at(&self, [x, y]: [f32; 2]) -> [f32; 4] {
         if !(x.is_finite() && y.is_finite()) {
             return [0.0; 4];
         }
-        let [sx, sy] = self.unit;
+        let [sx, sy, ..] = self.scale.to_array();
         let (i0, tx) = split(x * sx - 0.5);
         let (j0, ty) = split(y * sy - 0.5);
         if tx == 0.0 && ty == 0.0 {
