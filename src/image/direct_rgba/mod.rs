@@ -19,10 +19,11 @@
 //! small ring for its turn: placing each group twice (once to prefetch,
 //! once to sample) cost a quarter of the time. The positions themselves
 //! are asked for a few groups before they are placed. Past that, on a
-//! Xeon both are bound by the instructions a pixel takes. On an EPYC a
-//! dissolve's pixel takes nearly as long with every byte in cache as at
-//! 1080p (a warp's taps add 15–30 %), and a quarter fewer instructions
-//! did not make it faster (docs/PERFORMANCE.md).
+//! Xeon both are bound by the instructions a pixel takes, and so is the
+//! dissolve on a Zen 5 EPYC. On a Zen 3 EPYC a dissolve's pixel takes
+//! nearly as long with every byte in cache as at 1080p (a warp's taps
+//! add 15–30 %), and a quarter fewer instructions did not make it faster
+//! (docs/PERFORMANCE.md).
 //!
 //! Bilinear values are bit for bit those of the general path for other
 //! sample types and of the separate blend (the same fused multiply-adds in
@@ -277,12 +278,19 @@ impl<'a, T: Sample> Taps<'a, T> {
 
     /// The eight samples (two pixels of a tap row) from index `lower` and
     /// the eight `span` after them, as the row below and the row above,
-    /// with one bounds check on the samples between them instead of one
-    /// per load: the offsets of both within it are known to the compiler
-    /// (each 0 or `span`, and `span` a `u32`). `FLIP` is
-    /// [`Self::flipped`], a constant in each row's loop ([`row`],
-    /// [`blend_row`]): chosen per pixel, it cost a dozen instructions
-    /// and the checks the offsets spare.
+    /// from one slice of the samples between them: the offsets of both
+    /// within it are known to the compiler (each 0 or `span`, and `span`
+    /// a `u32`). `FLIP` is [`Self::flipped`], a constant in each row's
+    /// loop ([`row`], [`blend_row`]): chosen per pixel, it cost a dozen
+    /// instructions and the checks the offsets spare.
+    ///
+    /// `lower` is clamped to the last index such a slice may start at:
+    /// a no-op for the pixels that come here (both rows inside), and
+    /// what lets the compiler see the slice is in bounds. In place of the
+    /// check (the slice's end computed, compared and branched on, for
+    /// every pixel of each source) it took 7 % of the dissolve's
+    /// instructions and 5–8 % of its time on a Zen 5 EPYC
+    /// (docs/PERFORMANCE.md).
     #[inline(always)]
     fn rows_at<const FLIP: bool>(&self, lower: i32) -> (f32x8, f32x8) {
         debug_assert_eq!(FLIP, self.flipped);
@@ -290,6 +298,13 @@ impl<'a, T: Sample> Taps<'a, T> {
         // Indices inside the buffer, which fits `i32`; through `u32` the
         // slice end cannot overflow.
         let lower = lower as u32 as usize;
+        let last = self
+            .data
+            .len()
+            .checked_sub(span + 8)
+            .expect("a pixel with both tap rows inside has them in the buffer");
+        debug_assert!(lower <= last, "a fast pixel's taps lie inside");
+        let lower = lower.min(last);
         let both = &self.data[lower..lower + span + 8];
         let (below, above) = if FLIP { (span, 0) } else { (0, span) };
         (T::load8(&both[below..]), T::load8(&both[above..]))
