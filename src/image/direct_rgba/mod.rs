@@ -289,7 +289,7 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// what lets the compiler see the slice is in bounds. In place of the
     /// check (the slice's end computed, compared and branched on, for
     /// every pixel of each source) it took 7 % of the dissolve's
-    /// instructions and 5–8 % of its time on a Zen 5 EPYC
+    /// instructions and 2–8 % of its time (median 5 %) on a Zen 5 EPYC
     /// (docs/PERFORMANCE.md).
     #[inline(always)]
     fn rows_at<const FLIP: bool>(&self, lower: i32) -> (f32x8, f32x8) {
