@@ -284,28 +284,19 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// loop ([`row`], [`blend_row`]): chosen per pixel, it cost a dozen
     /// instructions and the checks the offsets spare.
     ///
-    /// `lower` is clamped to the last index such a slice may start at:
-    /// a no-op for the pixels that come here (both rows inside), and
-    /// what lets the compiler see the slice is in bounds. In place of the
-    /// check (the slice's end computed, compared and branched on, for
-    /// every pixel of each source) it took 7 % of the dissolve's
-    /// instructions and 2–8 % of its time (median 5 %) on a Zen 5 EPYC
-    /// (docs/PERFORMANCE.md).
+    /// `lower` is clamped to the last index such a slice may start at
+    /// ([`Self::taps_from`]): a no-op for the pixels that come here (both
+    /// rows inside), and what lets the compiler see the slice is in
+    /// bounds. In place of the check (the slice's end computed, compared
+    /// and branched on, for every pixel of each source) it took 7 % of
+    /// the dissolve's instructions and 2–8 % of its time (median 5 %) on
+    /// a Zen 5 EPYC (docs/PERFORMANCE.md).
     #[inline(always)]
     fn rows_at<const FLIP: bool>(&self, lower: i32) -> (f32x8, f32x8) {
         debug_assert_eq!(FLIP, self.flipped);
         let span = self.span as usize;
-        // Indices inside the buffer, which fits `i32`; through `u32` the
-        // slice end cannot overflow.
-        let lower = lower as u32 as usize;
-        let last = self
-            .data
-            .len()
-            .checked_sub(span + 8)
-            .expect("a pixel with both tap rows inside has them in the buffer");
-        debug_assert!(lower <= last, "a fast pixel's taps lie inside");
-        let lower = lower.min(last);
-        let both = &self.data[lower..lower + span + 8];
+        // An index inside the buffer, which fits `i32`.
+        let both = self.taps_from(lower as u32 as usize, span + 8);
         let (below, above) = if FLIP { (span, 0) } else { (0, span) };
         (T::load8(&both[below..]), T::load8(&both[above..]))
     }
@@ -313,8 +304,8 @@ impl<'a, T: Sample> Taps<'a, T> {
     /// Bicubic's sixteen taps of a pixel whose first tap (that of its
     /// lowest row, [`Place::at`]) is at index `at`: the samples from the
     /// lowest to the highest of its four tap rows in the buffer, and where
-    /// in them tap row `r` (0 the lowest, up) starts. Clamped as
-    /// [`Self::rows_at`] is, so the compiler sees every load in bounds:
+    /// in them tap row `r` (0 the lowest, up) starts. Clamped
+    /// ([`Self::taps_from`]), so the compiler sees every load in bounds:
     /// one compare and move a pixel instead of a check on each of its
     /// eight loads, which took a fifth of a bicubic dissolve's
     /// instructions and about a tenth of its time (docs/PERFORMANCE.md).
@@ -328,19 +319,27 @@ impl<'a, T: Sample> Taps<'a, T> {
             true => at.wrapping_add(self.stride.wrapping_mul(3)),
             false => at,
         };
-        let start = start as u32 as usize;
-        let last = self
-            .data
-            .len()
-            .checked_sub(reach)
-            .expect("a pixel with all its tap rows inside has them in the buffer");
-        debug_assert!(start <= last, "a fast pixel's taps lie inside");
-        let start = start.min(last);
         let row = move |r: usize| match FLIP {
             true => (3 - r) * span,
             false => r * span,
         };
-        (&self.data[start..start + reach], row)
+        (self.taps_from(start as u32 as usize, reach), row)
+    }
+
+    /// The `reach` samples from index `start`, which a fast pixel's taps
+    /// lie within: `start` clamped to the last index such a slice may
+    /// begin at, a no-op for them, so that the compiler sees the slice in
+    /// bounds and, inlined, every load from it at offsets it knows.
+    #[inline(always)]
+    fn taps_from(&self, start: usize, reach: usize) -> &[T] {
+        let last = self
+            .data
+            .len()
+            .checked_sub(reach)
+            .expect("a fast pixel's taps lie in the buffer");
+        debug_assert!(start <= last, "a fast pixel's taps lie in the buffer");
+        let start = start.min(last);
+        &self.data[start..start + reach]
     }
 
     /// Pixel `k` of a located four, both axes on the fast path.
